@@ -1,0 +1,228 @@
+/**
+ * `mosaic`: run and check pipelines headless.
+ *
+ *   mosaic validate FILE...            exit 0 when valid, 2 with file:line:col messages otherwise
+ *   mosaic run FILE [options]          live per-block table (or --json lines); Ctrl-C stops cleanly
+ *   mosaic bench [options]             the standard performance suite (see `mosaic bench --help`)
+ */
+import { resolve } from "node:path";
+import { parseArgs } from "node:util";
+import { formatDiagnostic } from "../engine/diagnostics";
+import type { Telemetry } from "../engine/runtime/runtime";
+import { Host } from "../host/host";
+import { loadDspFromDisk, validatePipelineFile } from "../host/validate";
+import { runBench } from "./bench";
+import { renderTable } from "./table";
+
+const VERSION = "0.1.0";
+
+const HELP = `mosaic ${VERSION} — run MOSAIC pipelines headless
+
+Usage:
+  mosaic validate FILE...
+      Checks pipeline files (YAML syntax, block types, params, wiring, shapes, files they read).
+      Exit 0 when every file is valid, 2 otherwise; messages are file:line:col.
+  mosaic run FILE [--duration S] [--clock realtime|virtual] [--json] [--precision]
+                  [--log-dir DIR] [--start T]
+      Runs a pipeline and shows a live per-block table: desired and actual rate, status
+      (on time, lagging, stumbling, idle), compute time and drops. --json prints one JSON object
+      per line instead (telemetry at 20 Hz, events, a final summary). Ctrl-C stops cleanly and
+      flushes every log. Exit 0 on success, 1 on a runtime failure, 2 on an invalid file.
+        --duration S   stop after S seconds (virtual seconds with --clock virtual)
+        --clock        realtime (default) or virtual (as fast as possible, deterministic)
+        --precision    spin the last ~0.3 ms before each tick (less jitter, more CPU)
+        --log-dir DIR  base folder for relative Path logs (default: the pipeline's folder)
+        --start T      virtual clock start time, UNIX seconds (default 0)
+  mosaic bench [--duration S] [--only NAME[,NAME]] [--out DIR]
+      Runs the standard benchmarks and writes bench/results/*.json and *.md.
+  mosaic --help | --version
+`;
+
+function out(s: string): void {
+  process.stdout.write(s + "\n");
+}
+function err(s: string): void {
+  process.stderr.write(s + "\n");
+}
+
+async function cmdValidate(files: string[]): Promise<number> {
+  if (files.length === 0) {
+    err("mosaic validate: give at least one pipeline file");
+    return 2;
+  }
+  loadDspFromDisk();
+  let bad = false;
+  for (const f of files) {
+    const ds = await validatePipelineFile(f);
+    for (const d of ds) err(formatDiagnostic(d));
+    const errors = ds.filter((d) => d.severity === "error").length;
+    if (errors > 0) {
+      bad = true;
+      err(`${f}: invalid (${errors} error${errors === 1 ? "" : "s"})`);
+    } else {
+      out(`${f}: ok`);
+    }
+  }
+  return bad ? 2 : 0;
+}
+
+function summaryLines(t: Telemetry): string[] {
+  const lines: string[] = [];
+  for (const b of t.blocks) {
+    if (b.timer && b.timer.fired > 0 && b.timer.latenessP50Us === b.timer.latenessP50Us) {
+      lines.push(
+        `${b.name}: ${b.timer.fired} ticks, ${b.timer.missed} missed, lateness p50 ${b.timer.latenessP50Us} µs, p99 ${b.timer.latenessP99Us} µs, max ${Math.round(b.timer.latenessMaxUs)} µs`,
+      );
+    }
+  }
+  return lines;
+}
+
+async function cmdRun(args: string[]): Promise<number> {
+  const { values, positionals } = parseArgs({
+    args,
+    allowPositionals: true,
+    options: {
+      duration: { type: "string" },
+      clock: { type: "string", default: "realtime" },
+      json: { type: "boolean", default: false },
+      precision: { type: "boolean", default: false },
+      "log-dir": { type: "string" },
+      start: { type: "string" },
+    },
+  });
+  const file = positionals[0];
+  if (!file || positionals.length > 1) {
+    err("usage: mosaic run FILE [--duration S] [--clock realtime|virtual] [--json]");
+    return 2;
+  }
+  const mode = values.clock;
+  if (mode !== "realtime" && mode !== "virtual") {
+    err(`mosaic run: --clock must be realtime or virtual, not '${mode}'`);
+    return 2;
+  }
+  const duration = values.duration !== undefined ? Number(values.duration) : undefined;
+  if (duration !== undefined && !(duration > 0)) {
+    err(`mosaic run: --duration must be a positive number of seconds, not '${values.duration}'`);
+    return 2;
+  }
+  const start = values.start !== undefined ? Number(values.start) : 0;
+  if (!Number.isFinite(start)) {
+    err(`mosaic run: --start must be a number of seconds, not '${values.start}'`);
+    return 2;
+  }
+  const json = values.json;
+  const tty = process.stdout.isTTY === true && !json;
+  const color = tty && !process.env.NO_COLOR;
+  let latest: Telemetry | undefined;
+  let drawn = 0;
+  let fatal = false;
+  let blockErrors = 0;
+  const draw = (): void => {
+    if (!latest || !tty) return;
+    const lines = renderTable(latest, { color, width: process.stdout.columns || 120 });
+    let s = drawn > 0 ? `\x1b[${drawn}F` : "";
+    for (const l of lines) s += `\x1b[2K${l}\n`;
+    process.stdout.write(s);
+    drawn = lines.length;
+  };
+  let resolveDone!: (reason: string) => void;
+  const done = new Promise<string>((r) => (resolveDone = r));
+  const { host, diagnostics } = await Host.load(
+    file,
+    {
+      mode,
+      precision: values.precision,
+      ...(values["log-dir"] !== undefined ? { logDir: resolve(values["log-dir"]) } : {}),
+      virtualStart: start,
+      ...(mode === "virtual" && duration !== undefined ? { virtualDuration: duration } : {}),
+    },
+    {
+      telemetry: (t) => {
+        latest = t;
+        if (json) out(JSON.stringify({ type: "telemetry", ...t }));
+      },
+      event: (e) => {
+        if (e.level === "error") blockErrors++;
+        if (json) out(JSON.stringify({ type: "event", ...e }));
+        else {
+          if (tty && drawn > 0) {
+            process.stdout.write(`\x1b[${drawn}F\x1b[J`);
+            drawn = 0;
+          }
+          err(`${e.level}: ${e.block}: ${e.message}`);
+        }
+      },
+      finished: () => resolveDone("finished"),
+      fatal: (m) => {
+        fatal = true;
+        if (json) out(JSON.stringify({ type: "fatal", message: m }));
+        else err(`fatal: ${m}`);
+        resolveDone("fatal");
+      },
+    },
+  );
+  for (const d of diagnostics) err(formatDiagnostic(d));
+  if (!host) {
+    err(`${file}: invalid pipeline, not started`);
+    return 2;
+  }
+  const onSig = (): void => resolveDone("interrupted");
+  process.once("SIGINT", onSig);
+  process.once("SIGTERM", onSig);
+  const redraw = tty ? setInterval(draw, 250) : undefined;
+  const timer = mode === "realtime" && duration !== undefined ? setTimeout(() => resolveDone("duration"), duration * 1000) : undefined;
+  host.start();
+  const reason = await done;
+  if (timer) clearTimeout(timer);
+  if (redraw) clearInterval(redraw);
+  process.off("SIGINT", onSig);
+  process.off("SIGTERM", onSig);
+  const final = await host.stop();
+  latest = final;
+  const code = fatal ? 1 : blockErrors > 0 ? 1 : 0;
+  if (json) {
+    out(JSON.stringify({ type: "summary", reason, exitCode: code, logs: host.logFiles, ...final }));
+  } else {
+    if (tty) draw();
+    else for (const l of renderTable(final, { color: false })) out(l);
+    for (const l of summaryLines(final)) out(l);
+    const why =
+      reason === "finished"
+        ? mode === "virtual" && duration !== undefined
+          ? "virtual duration reached"
+          : "input exhausted"
+        : reason === "duration"
+          ? "duration reached"
+          : reason === "interrupted"
+            ? "interrupted"
+            : "failed";
+    out(`stopped: ${why}${blockErrors ? `; ${blockErrors} block error${blockErrors === 1 ? "" : "s"} (see above)` : ""}`);
+  }
+  return code;
+}
+
+export async function main(argv: string[]): Promise<number> {
+  const [cmd, ...rest] = argv;
+  switch (cmd) {
+    case undefined:
+    case "-h":
+    case "--help":
+    case "help":
+      out(HELP);
+      return cmd === undefined ? 2 : 0;
+    case "-v":
+    case "--version":
+      out(VERSION);
+      return 0;
+    case "validate":
+      return cmdValidate(rest);
+    case "run":
+      return cmdRun(rest);
+    case "bench":
+      return runBench(rest);
+    default:
+      err(`mosaic: unknown command '${cmd}' (commands: validate, run, bench; see mosaic --help)`);
+      return 2;
+  }
+}

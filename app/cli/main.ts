@@ -1,0 +1,12 @@
+/** Entry point of the `mosaic` command (bundled to dist/cli.mjs). */
+import { main } from "./commands";
+
+main(process.argv.slice(2)).then(
+  (code) => {
+    process.exitCode = code;
+  },
+  (e: unknown) => {
+    err(`mosaic: ${(e as Error).stack ?? String(e)}`);
+    process.exitCode = 1;
+  },
+);

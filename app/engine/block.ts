@@ -1,0 +1,184 @@
+/**
+ * The block API. A block type is one `defineBlock({...})` call: its zod params schema is the single
+ * source of truth for the TypeScript type, the JSON Schema, the control-panel form and the docs.
+ *
+ * Life cycle: `create(ctx, params)` (at load: allocate state, declare outputs, no I/O besides
+ * reading files it needs to know its output shape) → `start()` (the pipeline runs: open devices,
+ * timers begin) → `process(frame, port)` for every input frame → `stop()` → `dispose()`.
+ */
+import type { z } from "zod";
+import type { Frame, Shape } from "./frame";
+import type { LogChannel } from "./runtime/logsink";
+
+export type BlockCategory =
+  | "Timing"
+  | "Sources"
+  | "Signal processing"
+  | "Features"
+  | "Flow control"
+  | "Learning"
+  | "Control"
+  | "Communication"
+  | "Devices"
+  | "Recording"
+  | "Testing";
+
+/** Control-panel views a block offers (drawn by the UI). */
+export type BlockView = "scope" | "spider" | "heatmap" | "label" | "stimulus";
+
+export interface InputSpec {
+  /** Fewest inputs the block accepts. */
+  min: number;
+  /** Most inputs the block accepts (Infinity for any number). */
+  max: number;
+  /** Optional names of the input positions, for messages and the UI ("signal", "timer"). */
+  labels?: readonly string[];
+}
+
+export interface InputInfo {
+  /** Position of this input in the block's `Inputs` list. */
+  readonly index: number;
+  /** The reference as written, without the leading '-': "Block" or "Block.port". */
+  readonly source: string;
+  readonly block: string;
+  readonly port: string;
+  /** The source's output shape; null only inside a feedback cycle whose source is created later. */
+  readonly shape: Shape | null;
+  /** The source's desired rate in Hz; 0 when aperiodic or unknown. */
+  readonly rate: number;
+  /** True when the source is a timer (its events carry no values). */
+  readonly isTimer: boolean;
+  /** False for inputs written `-Name`: declared, subscribed only at run time. */
+  readonly subscribed: boolean;
+}
+
+/** File access for blocks; paths are resolved against the pipeline file's folder. */
+export interface Resources {
+  resolve(path: string): string;
+  readText(path: string): Promise<string>;
+}
+
+export interface TimerHandle {
+  start(): void;
+  stop(): void;
+  readonly running: boolean;
+  /** Ticks fired since creation. */
+  readonly fired: number;
+  /** Ticks skipped because the worker woke too late (never fired late in a burst). */
+  readonly missed: number;
+  setRate(hz: number): void;
+}
+
+export interface OutputPort {
+  readonly name: string;
+  readonly shape: Shape;
+  /** A writable frame with room for `n` events and `frame.n === n`. */
+  frame(n: number): Frame;
+  /** Sends a frame obtained from `frame()`; the port takes it back once delivered. */
+  emit(frame: Frame): void;
+  /** True when nothing listens (no subscribed edge, no log): a block may skip work. */
+  readonly idle: boolean;
+}
+
+export interface BlockContext {
+  readonly name: string;
+  readonly type: string;
+  readonly inputs: readonly InputInfo[];
+  /** The rate written as `DesiredRate`, if any. */
+  readonly declaredRate: number | undefined;
+  /** The resolved desired rate in Hz (declared, or inherited from the inputs); 0 = aperiodic. */
+  readonly desiredRate: number;
+  /** Overrides the resolved desired rate (e.g. a FilePlayer that learns it from the file). */
+  setDesiredRate(hz: number): void;
+  /** Current time on the pipeline clock, UNIX seconds (virtual time under the virtual clock). */
+  now(): number;
+  /** Clock time at which the pipeline started (valid from `start()` on). */
+  readonly startTime: number;
+  /** True under the virtual clock (as fast as possible, deterministic). */
+  readonly virtual: boolean;
+  readonly resources: Resources;
+  /** Declares an output port (the first declared port is the default one). */
+  output(shape: Shape, port?: string): OutputPort;
+  /** A periodic callback on the high-resolution scheduler; missed ticks are skipped and counted. */
+  every(hz: number, tick: (t: number) => void): TimerHandle;
+  /** A one-shot callback at clock time `t`; a later call replaces a pending one. */
+  at(t: number, fn: (t: number) => void): void;
+  /** One line of live status text ("waiting for device", "row 120/2000"). */
+  setText(text: string): void;
+  /** A warning shown in the block's status (and printed by the CLI), rate-limited. */
+  warn(message: string): void;
+  /** Declares that this (finite) source is exhausted; a run ends when all finite sources are. */
+  finish(): void;
+  /**
+   * Opens a log file in the same line format as `Path` (for the Logger block). `path` is a folder
+   * or a file, like `Path`; `stream` names the file inside a folder (`<stream>.txt`). Returns null
+   * when this runtime has no log sink (then say so in the block's status).
+   */
+  openLog(path: string, stream: string, shape: Shape): LogChannel | null;
+}
+
+export interface BlockAction {
+  label: string;
+  description?: string;
+  run(arg?: unknown): string | void;
+}
+
+export interface BlockInstance {
+  process?(frame: Frame, port: number): void;
+  start?(): void;
+  stop?(): void;
+  /** Clears internal state: after reset the block behaves as if just created. */
+  reset?(): void;
+  dispose?(): void;
+  actions?: Record<string, BlockAction>;
+  /** Applies a live-settable param (already validated against the schema). */
+  setParam?(name: string, value: unknown): void;
+}
+
+export interface BlockDefinition<S extends z.ZodType = z.ZodType> {
+  /** Never changes once released: saved pipelines depend on it. */
+  type: string;
+  category: BlockCategory;
+  /** One line. */
+  summary: string;
+  /** One paragraph of help (Markdown), with references where the block implements a published definition. */
+  help: string;
+  params: S;
+  /**
+   * Converts MOSAIC's positional `Params` (a list of strings such as `[multiply:5]` or
+   * `[b0;b1;b2, 1;a1;a2]`) into the named form, which is then validated by `params`.
+   */
+  legacyParams?: (args: readonly string[]) => unknown;
+  /** The positional form, for docs: e.g. "[numerator, denominator] as a;b;c vectors". */
+  legacyForm?: string;
+  inputs: InputSpec;
+  /** Output port names; the first is the default. A function when ports depend on params. */
+  outputs?: readonly string[] | ((params: z.output<S>) => readonly string[]);
+  /** Timers drive pipelines: their ticks carry no values and `DesiredRate` is required. */
+  timer?: boolean;
+  /** True when the block needs `DesiredRate` written in the file. */
+  requiresRate?: boolean;
+  /** True when, with these params, the block is a finite source that calls `ctx.finish()`. */
+  finite?: (params: z.output<S>) => boolean;
+  /** Params that may be changed while running. */
+  live?: readonly string[];
+  /** Views its control panel offers. */
+  views?: readonly BlockView[];
+  /** What the control panel shows, in one sentence (drawn by the UI). */
+  panel?: string;
+  create(ctx: BlockContext, params: z.output<S>): BlockInstance | Promise<BlockInstance>;
+}
+
+/** Declares a block type; identity at run time, but infers the params type for `create`. */
+export function defineBlock<S extends z.ZodType>(def: BlockDefinition<S>): BlockDefinition<S> {
+  return def;
+}
+
+// eslint-disable-next-line @typescript-eslint/no-explicit-any
+export type AnyBlockDefinition = BlockDefinition<any>;
+
+export function outputNames(def: AnyBlockDefinition, params: unknown): readonly string[] {
+  const o = def.outputs;
+  if (o === undefined) return ["out"];
+  return typeof o === "function" ? o(params) : o;
+}

@@ -1,0 +1,943 @@
+/**
+ * The runtime of one worker: instantiates the blocks placed on it, delivers frames along edges,
+ * fires timers, tracks status, answers control requests and produces telemetry.
+ *
+ * Delivery is breadth-first through one FIFO per worker: an emitted frame is queued on every
+ * subscribed edge (bounded, with an overflow policy and a drop counter) and the consumer runs when
+ * its turn comes. Blocks never re-enter, feedback cycles are fine, and the order of deliveries is
+ * deterministic, which the virtual clock relies on for byte-identical logs.
+ */
+import type {
+  AnyBlockDefinition,
+  BlockContext,
+  BlockInstance,
+  InputInfo,
+  OutputPort,
+  Resources,
+  TimerHandle,
+} from "../block";
+import type { Catalog } from "../catalog";
+import { BlockConfigError, errorMessage, type Diagnostic } from "../diagnostics";
+import { Frame, FramePool, formatShape, type Shape } from "../frame";
+import type { BlockSpec, PipelineSpec, QueuePolicy, SourcePos } from "../pipeline/loader";
+import type { Clock } from "../clock";
+import { Deque } from "./deque";
+import type { LogChannel, LogSink } from "./logsink";
+import type { SabRing } from "./sab-ring";
+import { Scheduler, type TimerEntry } from "./scheduler";
+import { StatusTracker, type Status } from "./status";
+
+// ---------------------------------------------------------------------------------------------
+// Telemetry types
+
+export interface BlockTelemetry {
+  name: string;
+  type: string;
+  worker: string;
+  status: Status;
+  lagging: boolean;
+  stumbling: boolean;
+  /** Actual rate over the last 100 outputs, Hz (0 when unknown). */
+  rate: number;
+  desiredRate: number;
+  events: number;
+  computeLastMs: number;
+  computeMeanMs: number;
+  computeMaxMs: number;
+  /** Mean (emission time − event timestamp) since the previous telemetry, ms. */
+  latencyMs: number;
+  /** Events dropped on the edges into this block (all time). */
+  dropsIn: number;
+  text: string;
+  errors: number;
+  lastError: string;
+  finished: boolean;
+  /** Timers only. */
+  timer?: { fired: number; missed: number; latenessP50Us: number; latenessP99Us: number; latenessMaxUs: number; running: boolean };
+  /** ΔT between consecutive outputs (emission clock), since start or the last `resetTiming`. */
+  timing: { n: number; meanDt: number; stdDt: number; computeTotalMs: number; calls: number };
+}
+
+export interface EdgeTelemetry {
+  id: number;
+  from: string;
+  fromPort: string;
+  to: string;
+  toIndex: number;
+  subscribed: boolean;
+  rate: number;
+  delivered: number;
+  dropped: number;
+  pending: number;
+}
+
+export interface RuntimeEvent {
+  t: number;
+  level: "error" | "warning" | "info";
+  block: string;
+  message: string;
+}
+
+export interface Telemetry {
+  t: number;
+  worker: string;
+  blocks: BlockTelemetry[];
+  edges: EdgeTelemetry[];
+  events: RuntimeEvent[];
+  finished: boolean;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Plan: what every worker must know about every block (shapes and rates), computed once.
+
+export interface PlanBlock {
+  name: string;
+  worker: string;
+  desiredRate: number;
+  isTimer: boolean;
+  finite: boolean;
+  outputs: { name: string; shape: Shape }[];
+}
+export interface Plan {
+  blocks: PlanBlock[];
+}
+
+// ---------------------------------------------------------------------------------------------
+
+const DEFAULT_QUEUE_MIN = 64;
+const WARN_INTERVAL_S = 2;
+
+export interface RemoteSender {
+  /** Copies the frame into the cross-worker ring; returns events dropped (ring full). */
+  write(frame: Frame): number;
+}
+
+export interface RuntimeOptions {
+  spec: PipelineSpec;
+  catalog: Catalog;
+  clock: Clock;
+  virtual: boolean;
+  resources: Resources;
+  logs?: LogSink;
+  /** Name of this worker ("main" by default); blocks placed elsewhere are not instantiated. */
+  worker?: string;
+  /** Shapes and rates from the planning worker, required when blocks live on other workers. */
+  plan?: Plan;
+  /** Run every block here regardless of its `Worker` key (the virtual clock does this). */
+  ignorePlacement?: boolean;
+}
+
+class Edge {
+  readonly queue = new Deque<Frame>(8);
+  pendingEvents = 0;
+  skip = 0;
+  delivered = 0;
+  dropped = 0;
+  readonly times = new Float64Array(100);
+  private ti = 0;
+  private tn = 0;
+  one: Frame | null = null;
+  /** Consumer side of a cross-worker edge: the ring to drain, and frames to read into. */
+  inbound: SabRing | null = null;
+  inPool: FramePool | null = null;
+  /** The source's output shape (known from the plan even when the source is on another worker). */
+  srcShape: Shape | null = null;
+
+  constructor(
+    readonly id: number,
+    readonly fromName: string,
+    readonly fromPort: OutPort | null,
+    readonly fromPortName: string,
+    readonly to: Node,
+    readonly toIndex: number,
+    public subscribed: boolean,
+    readonly policy: QueuePolicy,
+    readonly capacity: number,
+  ) {}
+
+  noteTimes(f: Frame): void {
+    const n = f.n;
+    const s = n > 100 ? n - 100 : 0;
+    for (let i = s; i < n; i++) {
+      this.times[this.ti] = f.t[i]!;
+      this.ti = (this.ti + 1) % 100;
+    }
+    this.tn = Math.min(100, this.tn + n - s);
+  }
+
+  rate(): number {
+    if (this.tn < 2) return 0;
+    const last = this.times[(this.ti - 1 + 100) % 100]!;
+    const first = this.times[(this.ti - this.tn + 100) % 100]!;
+    return last > first ? (this.tn - 1) / (last - first) : 0;
+  }
+}
+
+class OutPort implements OutputPort {
+  readonly pool: FramePool;
+  readonly edges: Edge[] = [];
+  log: LogChannel | null = null;
+  /** Observers of every emitted frame (tests, open control panels); they must copy what they keep. */
+  taps: ((f: Frame) => void)[] = [];
+  /** Producer side of cross-worker edges. */
+  remotes: RemoteSender[] = [];
+
+  constructor(
+    readonly node: Node,
+    readonly name: string,
+    readonly shape: Shape,
+  ) {
+    this.pool = new FramePool(shape);
+  }
+
+  get idle(): boolean {
+    if (this.log || this.taps.length > 0 || this.remotes.length > 0) return false;
+    for (const e of this.edges) if (e.subscribed) return false;
+    return true;
+  }
+
+  frame(n: number): Frame {
+    return this.pool.take(n);
+  }
+
+  emit(frame: Frame): void {
+    this.node.rt.emit(this, frame);
+  }
+}
+
+class Node {
+  instance: BlockInstance = {};
+  readonly ports: OutPort[] = [];
+  readonly inEdges: Edge[] = [];
+  readonly status: StatusTracker;
+  readonly timers: TimerEntry[] = [];
+  oneShot: TimerEntry | null = null;
+  text = "";
+  errors = 0;
+  lastError = "";
+  lastWarnAt = -Infinity;
+  finished = false;
+  finite = false;
+  readonly extraLogs: LogChannel[] = [];
+  started = false;
+  params: unknown;
+
+  constructor(
+    readonly rt: Runtime,
+    readonly spec: BlockSpec,
+    readonly def: AnyBlockDefinition,
+    public desiredRate: number,
+    readonly local: boolean,
+  ) {
+    this.status = new StatusTracker(desiredRate);
+    this.params = spec.params;
+    this.finite = def.finite?.(spec.params) ?? false;
+  }
+
+  get name(): string {
+    return this.spec.name;
+  }
+}
+
+/** A block placed on another worker: known only through the plan. */
+interface Ghost {
+  name: string;
+  worker: string;
+  desiredRate: number;
+  isTimer: boolean;
+  outputs: Map<string, Shape>;
+}
+
+export interface CreateResult {
+  runtime: Runtime | undefined;
+  diagnostics: Diagnostic[];
+  plan: Plan | undefined;
+}
+
+function topoOrder(spec: PipelineSpec): BlockSpec[] {
+  const indeg = new Map<string, number>();
+  const outs = new Map<string, string[]>();
+  for (const b of spec.blocks) {
+    indeg.set(b.name, 0);
+    outs.set(b.name, []);
+  }
+  for (const b of spec.blocks) {
+    for (const inp of b.inputs) {
+      if (!indeg.has(inp.block) || inp.block === b.name) continue;
+      indeg.set(b.name, indeg.get(b.name)! + 1);
+      outs.get(inp.block)!.push(b.name);
+    }
+  }
+  const order: BlockSpec[] = [];
+  const done = new Set<string>();
+  while (order.length < spec.blocks.length) {
+    let next = spec.blocks.find((b) => !done.has(b.name) && indeg.get(b.name) === 0);
+    // Inside a feedback cycle: take the first remaining block in file order.
+    next ??= spec.blocks.find((b) => !done.has(b.name))!;
+    done.add(next.name);
+    order.push(next);
+    for (const o of outs.get(next.name)!) indeg.set(o, indeg.get(o)! - 1);
+  }
+  return order;
+}
+
+export class Runtime {
+  readonly worker: string;
+  readonly clock: Clock;
+  readonly virtual: boolean;
+  readonly scheduler: Scheduler;
+  readonly nodes: Node[] = [];
+  readonly byName = new Map<string, Node>();
+  readonly edges: Edge[] = [];
+  private readonly fifo = new Deque<Edge>(256);
+  private readonly events: RuntimeEvent[] = [];
+  private readonly logs: LogSink | undefined;
+  private readonly resources: Resources;
+  startTime = NaN;
+  running = false;
+  private finiteCount = 0;
+  private finishedCount = 0;
+  /** Called after a block asks for a wake-up (new timer, one-shot) so the host can re-plan its wait. */
+  onWake: (() => void) | null = null;
+
+  private constructor(
+    readonly spec: PipelineSpec,
+    opts: RuntimeOptions,
+  ) {
+    this.worker = opts.worker ?? "main";
+    this.clock = opts.clock;
+    this.virtual = opts.virtual;
+    this.scheduler = new Scheduler(opts.virtual);
+    this.logs = opts.logs;
+    this.resources = opts.resources;
+  }
+
+  /**
+   * Instantiates the pipeline's blocks for this worker in topological order, resolving every
+   * input's shape and rate. Never throws: block errors come back as diagnostics.
+   */
+  static async create(opts: RuntimeOptions): Promise<CreateResult> {
+    const rt = new Runtime(opts.spec, opts);
+    const diagnostics: Diagnostic[] = [];
+    const file = opts.spec.file;
+    const diag = (b: BlockSpec, pos: SourcePos, message: string, param?: string): void => {
+      diagnostics.push({
+        severity: "error",
+        code: "block-config",
+        message: `block '${b.name}' (${b.type}): ${message}`,
+        file,
+        line: pos.line,
+        col: pos.col,
+        block: b.name,
+        ...(param !== undefined ? { param } : {}),
+      });
+    };
+    const isLocal = (b: BlockSpec): boolean => opts.ignorePlacement === true || b.worker === rt.worker;
+    const ghosts = new Map<string, Ghost>();
+    if (opts.plan) {
+      for (const p of opts.plan.blocks) {
+        ghosts.set(p.name, {
+          name: p.name,
+          worker: p.worker,
+          desiredRate: p.desiredRate,
+          isTimer: p.isTimer,
+          outputs: new Map(p.outputs.map((o) => [o.name, o.shape])),
+        });
+      }
+    }
+    const order = topoOrder(opts.spec);
+    // Blocks on other workers are instantiated here only for planning (when no plan was given).
+    const planning: Node[] = [];
+    for (const b of order) {
+      const local = isLocal(b);
+      if (!local && opts.plan) continue;
+      const inputs: InputInfo[] = b.inputs.map((inp, index) => {
+        const src = rt.byName.get(inp.block) ?? planning.find((n) => n.name === inp.block);
+        const ghost = ghosts.get(inp.block);
+        const shape = src
+          ? (src.ports.find((p) => p.name === inp.port)?.shape ?? null)
+          : (ghost?.outputs.get(inp.port) ?? null);
+        return {
+          index,
+          source: inp.source,
+          block: inp.block,
+          port: inp.port,
+          shape,
+          rate: src ? src.desiredRate : (ghost?.desiredRate ?? 0),
+          isTimer: src ? src.def.timer === true : (ghost?.isTimer ?? false),
+          subscribed: inp.subscribed,
+        };
+      });
+      let desired = b.desiredRate ?? 0;
+      if (b.desiredRate === undefined) {
+        const timerIn = inputs.find((i) => i.isTimer && i.rate > 0);
+        const anyIn = inputs.find((i) => i.rate > 0);
+        desired = (timerIn ?? anyIn)?.rate ?? 0;
+      }
+      const node = new Node(rt, b, b.def, desired, local);
+      const ctx = rt.makeContext(node, inputs);
+      try {
+        node.instance = await b.def.create(ctx, b.params);
+      } catch (e) {
+        const param = e instanceof BlockConfigError ? e.param : undefined;
+        const pos = param !== undefined ? (b.paramPos[param.split(/[.[]/)[0]!] ?? b.paramsPos) : b.pos;
+        diag(b, pos, errorMessage(e), param);
+        continue;
+      }
+      node.status.desiredRate = node.desiredRate;
+      for (const out of b.outputs) {
+        if (!node.ports.some((p) => p.name === out)) {
+          diag(b, b.pos, `internal error: the block did not declare its output '${out}'`);
+        }
+      }
+      if (local) {
+        rt.nodes.push(node);
+        rt.byName.set(b.name, node);
+      } else {
+        planning.push(node);
+      }
+    }
+    if (diagnostics.length > 0) {
+      for (const n of [...rt.nodes, ...planning]) rt.safeDispose(n);
+      return { runtime: undefined, diagnostics, plan: undefined };
+    }
+    // The plan, for workers that did not see the other blocks.
+    const plan: Plan = opts.plan ?? {
+      blocks: order.map((b) => {
+        const n = rt.byName.get(b.name) ?? planning.find((x) => x.name === b.name)!;
+        return {
+          name: b.name,
+          worker: b.worker,
+          desiredRate: n.desiredRate,
+          isTimer: b.def.timer === true,
+          finite: n.finite,
+          outputs: n.ports.map((p) => ({ name: p.name, shape: p.shape })),
+        };
+      }),
+    };
+    for (const n of planning) rt.safeDispose(n);
+
+    // Edges (in file order of consumers, so delivery order is stable).
+    for (const b of opts.spec.blocks) {
+      const to = rt.byName.get(b.name);
+      if (!to) continue;
+      b.inputs.forEach((inp, index) => {
+        const from = rt.byName.get(inp.block);
+        const fromPort = from?.ports.find((p) => p.name === inp.port) ?? null;
+        const srcShape = fromPort?.shape ?? ghosts.get(inp.block)?.outputs.get(inp.port);
+        const srcRate = from?.desiredRate ?? ghosts.get(inp.block)?.desiredRate ?? 0;
+        const cap = b.queue.capacity ?? Math.max(DEFAULT_QUEUE_MIN, Math.ceil(srcRate));
+        const e = new Edge(
+          rt.edges.length,
+          inp.block,
+          fromPort,
+          inp.port,
+          to,
+          index,
+          inp.subscribed,
+          b.queue.policy,
+          cap,
+        );
+        e.srcShape = srcShape ?? null;
+        if (srcShape && b.queue.policy === "latest") e.one = new Frame(srcShape, 1);
+        rt.edges.push(e);
+        to.inEdges.push(e);
+        fromPort?.edges.push(e);
+      });
+    }
+    // Path logs
+    if (rt.logs) {
+      for (const n of rt.nodes) {
+        if (n.spec.path === undefined) continue;
+        n.ports.forEach((p, i) => {
+          p.log = rt.logs!.open(n.name, p.name, i === 0, n.spec.path!, p.shape);
+        });
+      }
+    }
+    for (const n of rt.nodes) if (n.finite) rt.finiteCount++;
+    return { runtime: rt, diagnostics, plan };
+  }
+
+  private safeDispose(n: Node): void {
+    try {
+      n.instance.dispose?.();
+    } catch {
+      // disposal errors during a failed load are not the user's first problem
+    }
+  }
+
+  private makeContext(node: Node, inputs: InputInfo[]): BlockContext {
+    const rt = this;
+    const sched = this.scheduler;
+    return {
+      name: node.name,
+      type: node.spec.type,
+      inputs,
+      declaredRate: node.spec.desiredRate,
+      get desiredRate() {
+        return node.desiredRate;
+      },
+      setDesiredRate(hz: number) {
+        node.desiredRate = hz;
+        node.status.desiredRate = hz;
+      },
+      now: () => rt.clock.now(),
+      get startTime() {
+        return rt.startTime;
+      },
+      virtual: this.virtual,
+      resources: this.resources,
+      output(shape: Shape, port?: string): OutputPort {
+        const name = port ?? node.spec.outputs[node.ports.length] ?? "out";
+        if (node.ports.some((p) => p.name === name)) {
+          throw new Error(`output '${name}' declared twice`);
+        }
+        if (!(shape.rows >= 1 && shape.cols >= 0 && Number.isInteger(shape.rows) && Number.isInteger(shape.cols))) {
+          throw new Error(`invalid output shape ${formatShape(shape)}`);
+        }
+        const p = new OutPort(node, name, shape);
+        node.ports.push(p);
+        return p;
+      },
+      every(hz: number, tick: (t: number) => void): TimerHandle {
+        if (!(hz > 0)) throw new BlockConfigError(`a timer rate must be positive, got ${hz}`);
+        const e = sched.add(node.name, 1 / hz, tick);
+        node.timers.push(e);
+        return {
+          start() {
+            if (!e.running) {
+              sched.start(e, rt.clock.now());
+              rt.onWake?.();
+            }
+          },
+          stop() {
+            sched.stop(e);
+          },
+          get running() {
+            return e.running;
+          },
+          get fired() {
+            return e.fired;
+          },
+          get missed() {
+            return e.missed;
+          },
+          setRate(h: number) {
+            if (!(h > 0)) throw new Error(`a timer rate must be positive, got ${h}`);
+            e.period = 1 / h;
+            if (e.running) sched.start(e, rt.clock.now());
+            rt.onWake?.();
+          },
+        };
+      },
+      at(t: number, fn: (t: number) => void) {
+        if (!node.oneShot) {
+          node.oneShot = sched.add(node.name, 0, fn);
+        }
+        node.oneShot.cb = fn;
+        sched.once(node.oneShot, t);
+        rt.onWake?.();
+      },
+      setText(text: string) {
+        node.text = text;
+      },
+      warn(message: string) {
+        rt.warn(node, message);
+      },
+      openLog(path: string, stream: string, shape: Shape): LogChannel | null {
+        if (!rt.logs) return null;
+        const ch = rt.logs.open(stream, "out", true, path, shape);
+        node.extraLogs.push(ch);
+        return ch;
+      },
+      finish() {
+        if (!node.finished) {
+          node.finished = true;
+          if (node.finite) rt.finishedCount++;
+        }
+      },
+    };
+  }
+
+  // -------------------------------------------------------------------------------------------
+  // Hot path
+
+  emit(port: OutPort, f: Frame): void {
+    if (f.n <= 0) {
+      if (f.refs === 0) f.pool?.release(f);
+      return;
+    }
+    const now = this.clock.now();
+    port.node.status.record(f, now);
+    if (port.log) port.log.write(f);
+    const taps = port.taps;
+    for (let i = 0; i < taps.length; i++) taps[i]!(f);
+    const edges = port.edges;
+    for (let i = 0; i < edges.length; i++) {
+      const e = edges[i]!;
+      if (e.subscribed) this.push(e, f);
+    }
+    const remotes = port.remotes;
+    for (let i = 0; i < remotes.length; i++) remotes[i]!.write(f);
+    if (f.refs === 0) f.pool?.release(f);
+  }
+
+  /** Queues frame `f` on edge `e` (applying its policy). */
+  push(e: Edge, f: Frame): void {
+    e.noteTimes(f);
+    const n = f.n;
+    if (e.policy === "latest") {
+      this.cancelPending(e, e.queue.length);
+    } else if (e.pendingEvents + n > e.capacity) {
+      if (e.policy === "drop-newest") {
+        e.dropped += n;
+        return;
+      }
+      while (e.queue.length > 0 && e.pendingEvents + n > e.capacity) this.cancelPending(e, 1);
+    }
+    e.delivered += n;
+    f.refs++;
+    e.queue.push(f);
+    e.pendingEvents += n;
+    this.fifo.push(e);
+  }
+
+  private cancelPending(e: Edge, count: number): void {
+    for (let i = 0; i < count; i++) {
+      const f = e.queue.shift();
+      if (!f) return;
+      e.pendingEvents -= f.n;
+      e.dropped += f.n;
+      e.delivered -= f.n;
+      e.skip++;
+      if (--f.refs === 0) f.pool?.release(f);
+    }
+  }
+
+  /** Delivers queued frames until the FIFO is empty. */
+  dispatch(): void {
+    const fifo = this.fifo;
+    while (fifo.length > 0) {
+      const e = fifo.shift()!;
+      if (e.skip > 0) {
+        e.skip--;
+        continue;
+      }
+      const f = e.queue.shift()!;
+      e.pendingEvents -= f.n;
+      let g = f;
+      if (e.policy === "latest" && f.n > 1 && e.one) {
+        e.one.copyEvents(f, f.n - 1, 1, 0);
+        e.one.n = 1;
+        e.dropped += f.n - 1;
+        g = e.one;
+      }
+      this.deliver(e.to, g, e.toIndex);
+      if (--f.refs === 0) f.pool?.release(f);
+    }
+  }
+
+  private deliver(node: Node, f: Frame, port: number): void {
+    const proc = node.instance.process;
+    if (!proc || !node.started) return;
+    const t0 = performance.now();
+    try {
+      proc.call(node.instance, f, port);
+    } catch (err) {
+      this.fail(node, err);
+    }
+    node.status.compute(performance.now() - t0, this.clock.now());
+  }
+
+  private fireEntry = (e: TimerEntry, t: number): void => {
+    const node = this.byName.get(e.owner);
+    if (!node || !node.started) return;
+    const t0 = performance.now();
+    try {
+      e.cb(t);
+    } catch (err) {
+      this.fail(node, err);
+    }
+    node.status.compute(performance.now() - t0, this.clock.now());
+  };
+
+  /** Fires every timer due at `now` (then call `dispatch`). */
+  fireDue(now: number): number {
+    return this.scheduler.fireDue(now, this.fireEntry);
+  }
+
+  /** One step of the loop: take in frames from other workers, fire due timers, deliver. */
+  step(now: number): void {
+    if (this.inbound.length > 0) this.drainInbound();
+    this.fireDue(now);
+    this.dispatch();
+  }
+
+  private readonly inbound: Edge[] = [];
+
+  /** Sends what `block`'s output `port` emits into a cross-worker ring too. */
+  attachRemoteOut(block: string, port: string, sender: RemoteSender): void {
+    const node = this.byName.get(block);
+    const p = node?.ports.find((x) => x.name === port);
+    if (!p) throw new Error(`no output '${block}.${port}' on worker '${this.worker}'`);
+    p.remotes.push(sender);
+  }
+
+  /** Feeds input `index` of `block` from a cross-worker ring (drained in `step`). */
+  attachRemoteIn(block: string, index: number, ring: SabRing): void {
+    const node = this.byName.get(block);
+    const e = node?.inEdges.find((x) => x.toIndex === index);
+    if (!e) throw new Error(`no input ${index} of '${block}' on worker '${this.worker}'`);
+    e.inbound = ring;
+    e.inPool = new FramePool(e.srcShape ?? { rows: 1, cols: ring.stride }, 64);
+    this.inbound.push(e);
+  }
+
+  /** Moves events waiting in cross-worker rings onto their edges. */
+  drainInbound(): void {
+    for (const e of this.inbound) {
+      const ring = e.inbound!;
+      while (ring.available() > 0) {
+        const f = e.inPool!.take(0);
+        f.pool = e.inPool;
+        ring.read(f);
+        if (e.subscribed && f.n > 0) this.push(e, f);
+        if (f.refs === 0) e.inPool!.release(f);
+      }
+    }
+  }
+
+  nextDeadline(): number {
+    return this.scheduler.nextDeadline();
+  }
+
+  get pending(): number {
+    return this.fifo.length;
+  }
+
+  /** True when every finite source has finished (never true without finite sources). */
+  get finished(): boolean {
+    return this.finiteCount > 0 && this.finishedCount >= this.finiteCount;
+  }
+
+  private fail(node: Node, err: unknown): void {
+    node.errors++;
+    node.lastError = errorMessage(err);
+    const now = this.clock.now();
+    if (now - node.lastWarnAt >= WARN_INTERVAL_S || node.errors === 1) {
+      node.lastWarnAt = now;
+      this.events.push({
+        t: now,
+        level: "error",
+        block: node.name,
+        message: `${node.lastError}${node.errors > 1 ? ` (${node.errors} errors so far)` : ""}`,
+      });
+    }
+  }
+
+  private warn(node: Node, message: string): void {
+    const now = this.clock.now();
+    if (now - node.lastWarnAt < WARN_INTERVAL_S && node.lastError === message) return;
+    node.lastWarnAt = now;
+    this.events.push({ t: now, level: "warning", block: node.name, message });
+  }
+
+  // -------------------------------------------------------------------------------------------
+  // Life cycle
+
+  start(): void {
+    if (this.running) return;
+    this.running = true;
+    this.startTime = this.clock.now();
+    for (const n of this.nodes) n.started = true;
+    for (const n of this.nodes) {
+      try {
+        n.instance.start?.();
+      } catch (err) {
+        this.fail(n, err);
+      }
+    }
+  }
+
+  stop(): void {
+    if (!this.running) return;
+    this.running = false;
+    for (const n of this.nodes) {
+      for (const t of n.timers) this.scheduler.stop(t);
+      if (n.oneShot) this.scheduler.stop(n.oneShot);
+      try {
+        n.instance.stop?.();
+      } catch (err) {
+        this.fail(n, err);
+      }
+      n.started = false;
+    }
+  }
+
+  dispose(): void {
+    this.stop();
+    for (const n of this.nodes) {
+      this.safeDispose(n);
+      for (const p of n.ports) p.log?.close();
+      for (const l of n.extraLogs) l.close();
+    }
+  }
+
+  // -------------------------------------------------------------------------------------------
+  // Control
+
+  node(name: string): Node | undefined {
+    return this.byName.get(name);
+  }
+
+  /** Subscribes or unsubscribes a block's input at run time (the `-Name` inputs). */
+  setSubscribed(block: string, input: string | number, subscribed: boolean): string {
+    const node = this.byName.get(block);
+    if (!node) throw new Error(`no block '${block}' on worker '${this.worker}'`);
+    const edge =
+      typeof input === "number"
+        ? node.inEdges[input]
+        : node.inEdges.find((e) => node.spec.inputs[e.toIndex]!.source === input || node.spec.inputs[e.toIndex]!.block === input);
+    if (!edge) {
+      const names = node.spec.inputs.map((i) => i.source).join(", ");
+      throw new Error(`block '${block}' has no input '${String(input)}' (its inputs: ${names || "none"})`);
+    }
+    if (edge.subscribed === subscribed) return `${block} ${subscribed ? "already subscribed to" : "was not subscribed to"} ${node.spec.inputs[edge.toIndex]!.source}`;
+    edge.subscribed = subscribed;
+    if (!subscribed) this.cancelPending(edge, edge.queue.length);
+    return `${block} ${subscribed ? "subscribed to" : "unsubscribed from"} ${node.spec.inputs[edge.toIndex]!.source}`;
+  }
+
+  /** Runs a block action: built-ins `subscribe`, `unsubscribe`, `reset`, then the block's own. */
+  invoke(block: string, action: string, arg?: unknown): string {
+    const node = this.byName.get(block);
+    if (!node) throw new Error(`no block '${block}' on worker '${this.worker}'`);
+    if (action === "subscribe" || action === "unsubscribe") {
+      if (typeof arg !== "string" && typeof arg !== "number") {
+        throw new Error(`'${action}' needs the input's name or position`);
+      }
+      return this.setSubscribed(block, arg, action === "subscribe");
+    }
+    if (action === "reset") {
+      node.instance.reset?.();
+      return `${block} reset`;
+    }
+    const a = node.instance.actions?.[action];
+    if (!a) {
+      const names = ["subscribe", "unsubscribe", "reset", ...Object.keys(node.instance.actions ?? {})];
+      throw new Error(`block '${block}' has no action '${action}' (its actions: ${names.join(", ")})`);
+    }
+    const r = a.run(arg);
+    this.onWake?.();
+    return typeof r === "string" ? r : `${block}: ${a.label}`;
+  }
+
+  /** Sets a live parameter after validating it against the block's schema. */
+  setParam(block: string, param: string, value: unknown): string {
+    const node = this.byName.get(block);
+    if (!node) throw new Error(`no block '${block}' on worker '${this.worker}'`);
+    const live = node.def.live ?? [];
+    if (!live.includes(param)) {
+      throw new Error(
+        `param '${param}' of ${node.spec.type} cannot be changed while running` +
+          (live.length ? ` (live params: ${live.join(", ")})` : " (it has no live params)"),
+      );
+    }
+    const merged = { ...(node.params as Record<string, unknown>), [param]: value };
+    const r = node.def.params.safeParse(merged);
+    if (!r.success) {
+      const issue = r.error.issues[0]!;
+      throw new Error(`invalid value for '${param}': ${issue.message}`);
+    }
+    node.params = r.data;
+    node.instance.setParam?.(param, (r.data as Record<string, unknown>)[param]);
+    return `${block}.${param} = ${JSON.stringify(value)}`;
+  }
+
+  /** Observes every frame a block emits on `port` (default port when omitted); returns an unsubscribe. */
+  tap(block: string, port: string | undefined, fn: (f: Frame) => void): () => void {
+    const node = this.byName.get(block);
+    if (!node) throw new Error(`no block '${block}' on worker '${this.worker}'`);
+    const p = port === undefined ? node.ports[0] : node.ports.find((x) => x.name === port);
+    if (!p) throw new Error(`block '${block}' has no output '${port ?? "(default)"}'`);
+    p.taps.push(fn);
+    return () => {
+      p.taps = p.taps.filter((x) => x !== fn);
+    };
+  }
+
+  resetTiming(): void {
+    for (const n of this.nodes) {
+      n.status.resetTiming();
+      for (const t of n.timers) t.lateness?.reset();
+    }
+  }
+
+  // -------------------------------------------------------------------------------------------
+  // Telemetry
+
+  telemetry(): Telemetry {
+    const now = this.clock.now();
+    const blocks: BlockTelemetry[] = this.nodes.map((n) => {
+      const s = n.status;
+      const ev = s.evaluate(now);
+      let dropsIn = 0;
+      for (const e of n.inEdges) dropsIn += e.dropped;
+      const timer = n.def.timer ? n.timers[0] : undefined;
+      const bt: BlockTelemetry = {
+        name: n.name,
+        type: n.spec.type,
+        worker: this.worker,
+        status: ev.status,
+        lagging: ev.lagging,
+        stumbling: ev.stumbling,
+        rate: Number.isFinite(ev.rate) ? ev.rate : 0,
+        desiredRate: n.desiredRate,
+        events: s.events,
+        computeLastMs: s.computeLast,
+        computeMeanMs: s.callsWindow ? s.computeSumWindow / s.callsWindow : 0,
+        computeMaxMs: s.computeMaxWindow,
+        latencyMs: s.latencyN ? (s.latencySum / s.latencyN) * 1000 : 0,
+        dropsIn,
+        text: n.text,
+        errors: n.errors,
+        lastError: n.lastError,
+        finished: n.finished,
+        timing: {
+          n: s.dtN,
+          meanDt: s.dtMean,
+          stdDt: s.dtStd(),
+          computeTotalMs: s.computeTotal,
+          calls: s.calls,
+        },
+      };
+      if (timer) {
+        const h = timer.lateness;
+        bt.timer = {
+          fired: timer.fired,
+          missed: timer.missed,
+          latenessP50Us: h ? h.quantile(0.5) : 0,
+          latenessP99Us: h ? h.quantile(0.99) : 0,
+          latenessMaxUs: h && h.count ? h.maxUs : 0,
+          running: timer.running,
+        };
+      }
+      s.resetWindow();
+      return bt;
+    });
+    const edges: EdgeTelemetry[] = this.edges.map((e) => ({
+      id: e.id,
+      from: e.fromName,
+      fromPort: e.fromPortName,
+      to: e.to.name,
+      toIndex: e.toIndex,
+      subscribed: e.subscribed,
+      rate: e.rate(),
+      delivered: e.delivered,
+      dropped: e.dropped,
+      pending: e.pendingEvents,
+    }));
+    const events = this.events.splice(0, this.events.length);
+    return { t: now, worker: this.worker, blocks, edges, events, finished: this.finished };
+  }
+}

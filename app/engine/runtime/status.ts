@@ -1,0 +1,153 @@
+/**
+ * Timing status exactly as DESIGN.md §3 / the paper III-B:
+ * - rate = (n − 1) / (t_last − t_first) over the last 100 outputs (event timestamps);
+ * - idle (grey) when there was no output for 10 periods (or none at all);
+ * - lagging (red) when rate < 95 % of DesiredRate;
+ * - stumbling (magenta) when one `process` call (measured) took longer than 1 / DesiredRate
+ *   within the current 100-output window;
+ * - on time (green) otherwise. Precedence idle > lagging > stumbling > on time.
+ */
+import type { Frame } from "../frame";
+
+export type Status = "idle" | "lagging" | "stumbling" | "ontime";
+export const STATUSES: readonly Status[] = ["ontime", "idle", "lagging", "stumbling"];
+
+export const RATE_WINDOW = 100;
+export const LAG_FRACTION = 0.95;
+export const IDLE_PERIODS = 10;
+/** Idle threshold for blocks without a desired rate (aperiodic, e.g. triggers). */
+export const APERIODIC_IDLE_S = 1;
+
+export interface StatusEval {
+  status: Status;
+  rate: number;
+  lagging: boolean;
+  stumbling: boolean;
+}
+
+export class StatusTracker {
+  /** Event timestamps of the last RATE_WINDOW outputs (ring). */
+  private readonly ts = new Float64Array(RATE_WINDOW);
+  /** Clock time at which each of those outputs was emitted (ring). */
+  private readonly wall = new Float64Array(RATE_WINDOW);
+  private idx = 0;
+  private inWindow = 0;
+  /** Total output events. */
+  events = 0;
+  lastWall = -Infinity;
+  lastOverrunWall = -Infinity;
+
+  // compute time of `process` calls (ms)
+  calls = 0;
+  computeLast = 0;
+  computeMaxWindow = 0;
+  computeSumWindow = 0;
+  callsWindow = 0;
+  computeTotal = 0;
+
+  // latency: emission clock time − event timestamp (s), mean since last telemetry
+  latencySum = 0;
+  latencyN = 0;
+
+  // ΔT between consecutive outputs, by emission clock time (Welford), for the bench's Table 5
+  dtN = 0;
+  dtMean = 0;
+  dtM2 = 0;
+  private prevWall = NaN;
+
+  constructor(public desiredRate: number) {}
+
+  /** Records an emitted frame at clock time `now`. */
+  record(f: Frame, now: number): void {
+    const n = f.n;
+    const rate = this.desiredRate;
+    // Back from idle: the window restarts, so a pause does not read as lagging afterwards.
+    if (rate > 0 && now - this.lastWall > IDLE_PERIODS / rate) {
+      this.inWindow = 0;
+      this.prevWall = NaN;
+    }
+    const t = f.t;
+    const start = n > RATE_WINDOW ? n - RATE_WINDOW : 0;
+    for (let i = start; i < n; i++) {
+      this.ts[this.idx] = t[i]!;
+      this.wall[this.idx] = now;
+      this.idx = (this.idx + 1) % RATE_WINDOW;
+    }
+    this.inWindow = Math.min(RATE_WINDOW, this.inWindow + (n - start));
+    this.events += n;
+    this.lastWall = now;
+    this.latencySum += now - t[n - 1]!;
+    this.latencyN++;
+    // ΔT stats: the first event of the frame against the previous output, then 0 within a batch.
+    for (let i = 0; i < n; i++) {
+      if (this.prevWall === this.prevWall) {
+        const dt = now - this.prevWall;
+        this.dtN++;
+        const d = dt - this.dtMean;
+        this.dtMean += d / this.dtN;
+        this.dtM2 += d * (dt - this.dtMean);
+      }
+      this.prevWall = now;
+    }
+  }
+
+  /** Records one measured `process` (or timer callback) call of `ms` milliseconds. */
+  compute(ms: number, now: number): void {
+    this.calls++;
+    this.callsWindow++;
+    this.computeLast = ms;
+    this.computeSumWindow += ms;
+    this.computeTotal += ms;
+    if (ms > this.computeMaxWindow) this.computeMaxWindow = ms;
+    if (this.desiredRate > 0 && ms > 1000 / this.desiredRate) this.lastOverrunWall = now;
+  }
+
+  /** Rate over the window, Hz (NaN with fewer than two outputs). */
+  rate(): number {
+    const n = this.inWindow;
+    if (n < 2) return NaN;
+    const last = this.ts[(this.idx - 1 + RATE_WINDOW) % RATE_WINDOW]!;
+    const first = this.ts[(this.idx - n + RATE_WINDOW) % RATE_WINDOW]!;
+    const span = last - first;
+    if (!(span > 0)) return Infinity;
+    return (n - 1) / span;
+  }
+
+  evaluate(now: number): StatusEval {
+    const rate = this.rate();
+    const d = this.desiredRate;
+    const idleAfter = d > 0 ? IDLE_PERIODS / d : APERIODIC_IDLE_S;
+    if (this.events === 0 || now - this.lastWall > idleAfter) {
+      return { status: "idle", rate: this.events === 0 ? 0 : rate, lagging: false, stumbling: false };
+    }
+    const lagging = d > 0 && rate === rate && rate < LAG_FRACTION * d;
+    const n = this.inWindow;
+    const windowStart = n > 0 ? this.wall[(this.idx - n + RATE_WINDOW) % RATE_WINDOW]! : now;
+    const stumbling = d > 0 && this.lastOverrunWall >= windowStart;
+    const status: Status = lagging ? "lagging" : stumbling ? "stumbling" : "ontime";
+    return { status, rate, lagging, stumbling };
+  }
+
+  /** Resets the per-telemetry window counters (compute max/mean, latency). */
+  resetWindow(): void {
+    this.computeMaxWindow = 0;
+    this.computeSumWindow = 0;
+    this.callsWindow = 0;
+    this.latencySum = 0;
+    this.latencyN = 0;
+  }
+
+  /** Resets the ΔT statistics (e.g. after a bench warm-up). */
+  resetTiming(): void {
+    this.dtN = 0;
+    this.dtMean = 0;
+    this.dtM2 = 0;
+    this.prevWall = NaN;
+    this.computeTotal = 0;
+    this.calls = 0;
+  }
+
+  dtStd(): number {
+    return this.dtN > 1 ? Math.sqrt(this.dtM2 / (this.dtN - 1)) : NaN;
+  }
+}

@@ -1,0 +1,212 @@
+/**
+ * Engine worker (Node worker_threads): runs the blocks placed on it, on the real-time loop or on
+ * the virtual clock, and reports telemetry to the host at 20 Hz. The main thread never runs blocks.
+ */
+import { readFileSync } from "node:fs";
+import { dirname } from "node:path";
+import { parentPort } from "node:worker_threads";
+import { catalog } from "../blocks/catalog";
+import { VirtualClock, type Clock } from "../engine/clock";
+import type { Diagnostic } from "../engine/diagnostics";
+import { initDsp } from "../engine/dsp";
+import { errorMessage } from "../engine/diagnostics";
+import type { Frame, Shape } from "../engine/frame";
+import { loadPipeline } from "../engine/pipeline/loader";
+import type { LogChannel, LogSink } from "../engine/runtime/logsink";
+import { Runtime } from "../engine/runtime/runtime";
+import { SabRing } from "../engine/runtime/sab-ring";
+import { runVirtual } from "../engine/runtime/virtual";
+import { RealtimeLoop } from "./loop";
+import { nodeResources } from "./resources";
+import { clockFromBase } from "./time-base";
+import type { HostToWorker, InitMessage, WorkerToHost } from "./worker-protocol";
+
+const port = parentPort;
+if (!port) throw new Error("engine.worker must run in a worker thread");
+
+const post = (m: WorkerToHost): void => port.postMessage(m);
+
+let rt: Runtime | undefined;
+let loop: RealtimeLoop | undefined;
+let init: InitMessage | undefined;
+let vclock: VirtualClock | undefined;
+let stopped = false;
+const doorbellSab = new SharedArrayBuffer(4);
+const doorbell = new Int32Array(doorbellSab);
+const logRings: SabRing[] = [];
+
+/** Path logs travel to the host's log writer through one SAB ring each. */
+function sabLogSink(virtual: boolean): LogSink {
+  let nextId = 0;
+  return {
+    open(block: string, portName: string, isDefaultPort: boolean, path: string, shape: Shape): LogChannel {
+      const id = nextId++;
+      const stride = shape.rows * shape.cols;
+      // About two seconds of data at 2 kHz for small vectors, at least 1 MiB of doubles.
+      const capacity = Math.max(4096, Math.ceil((1 << 17) / (stride + 1)));
+      const init = SabRing.allocate(capacity, stride);
+      const ring = new SabRing(init);
+      logRings.push(ring);
+      post({ type: "log-open", id, block, port: portName, isDefaultPort, path, shape, ring: init });
+      return {
+        write(f: Frame) {
+          // Real time: a full ring drops and counts (the writer reports it); virtual: wait.
+          ring.write(f, virtual);
+        },
+        close() {
+          ring.close();
+          post({ type: "log-close", id });
+        },
+      };
+    },
+  };
+}
+
+async function create(msg: InitMessage): Promise<void> {
+  init = msg;
+  try {
+    initDsp(readFileSync(msg.wasmPath));
+  } catch (e) {
+    post({ type: "fatal", message: `cannot load the DSP core (${msg.wasmPath}): ${errorMessage(e)}` });
+    return;
+  }
+  const loaded = loadPipeline(msg.source, msg.file, catalog);
+  if (!loaded.spec) {
+    post({ type: "failed", diagnostics: loaded.diagnostics });
+    return;
+  }
+  const virtual = msg.mode === "virtual";
+  let clock: Clock;
+  if (virtual) {
+    vclock = new VirtualClock(msg.virtualStart);
+    clock = vclock;
+  } else {
+    clock = clockFromBase(msg.timeBase);
+  }
+  const created = await Runtime.create({
+    spec: loaded.spec,
+    catalog,
+    clock,
+    virtual,
+    resources: nodeResources(dirname(msg.file)),
+    logs: sabLogSink(virtual),
+    worker: msg.worker,
+    ...(msg.plan ? { plan: msg.plan } : {}),
+    ignorePlacement: virtual,
+  });
+  const diagnostics: Diagnostic[] = [...loaded.diagnostics, ...created.diagnostics];
+  if (!created.runtime || !created.plan) {
+    post({ type: "failed", diagnostics });
+    return;
+  }
+  rt = created.runtime;
+  post({ type: "created", plan: created.plan, diagnostics, doorbell: doorbellSab });
+}
+
+function link(msg: Extract<HostToWorker, { type: "link" }>): void {
+  if (!rt) return;
+  for (const o of msg.outs) {
+    const ring = new SabRing(o.ring);
+    const bell = new Int32Array(o.bell);
+    rt.attachRemoteOut(o.block, o.port, {
+      write(f: Frame) {
+        const lost = ring.write(f, false);
+        Atomics.add(bell, 0, 1);
+        Atomics.notify(bell, 0);
+        return lost;
+      },
+    });
+  }
+  for (const i of msg.ins) rt.attachRemoteIn(i.block, i.index, new SabRing(i.ring));
+}
+
+function start(): void {
+  if (!rt || !init) return;
+  const runtime = rt;
+  rt.start();
+  const telemetryIntervalS = 1 / init.telemetryHz;
+  if (init.mode === "virtual") {
+    const clock = vclock!;
+    const until = init.virtualStart + init.virtualDuration;
+    let lastTel = performance.now();
+    const chunk = (): void => {
+      if (stopped) return;
+      const r = runVirtual(runtime, clock, until, 20);
+      if (performance.now() - lastTel >= telemetryIntervalS * 1000) {
+        lastTel = performance.now();
+        post({ type: "telemetry", telemetry: runtime.telemetry() });
+      }
+      if (r === "yield") setImmediate(chunk);
+      else post({ type: "finished", telemetry: runtime.telemetry() });
+    };
+    setImmediate(chunk);
+    return;
+  }
+  loop = new RealtimeLoop({
+    runtime,
+    clock: rt.clock,
+    doorbell,
+    precision: init.precision,
+    telemetryIntervalS,
+    onTelemetry: () => post({ type: "telemetry", telemetry: runtime.telemetry() }),
+    onFinished: () => post({ type: "finished", telemetry: runtime.telemetry() }),
+  });
+  rt.onWake = () => loop?.wake();
+  loop.start();
+}
+
+function stop(): void {
+  if (stopped) return;
+  stopped = true;
+  loop?.stop();
+  if (rt) {
+    rt.stop();
+    rt.dispatch();
+    const telemetry = rt.telemetry();
+    rt.dispose();
+    post({ type: "stopped", telemetry });
+  } else {
+    post({ type: "stopped", telemetry: { t: 0, worker: init?.worker ?? "main", blocks: [], edges: [], events: [], finished: false } });
+  }
+}
+
+port.on("message", (msg: HostToWorker) => {
+  try {
+    switch (msg.type) {
+      case "init":
+        void create(msg).catch((e: unknown) => post({ type: "fatal", message: errorMessage(e) }));
+        break;
+      case "link":
+        link(msg);
+        break;
+      case "start":
+        start();
+        break;
+      case "stop":
+        stop();
+        break;
+      case "control": {
+        if (!rt) {
+          post({ type: "reply", id: msg.id, ok: false, message: "the pipeline is not running" });
+          break;
+        }
+        try {
+          let message = "";
+          if (msg.op === "invoke") message = rt.invoke(msg.block, msg.action, msg.arg);
+          else if (msg.op === "setParam") message = rt.setParam(msg.block, msg.param, msg.value);
+          else {
+            rt.resetTiming();
+            message = "timing statistics reset";
+          }
+          post({ type: "reply", id: msg.id, ok: true, message });
+        } catch (e) {
+          post({ type: "reply", id: msg.id, ok: false, message: errorMessage(e) });
+        }
+        loop?.wake();
+        break;
+      }
+    }
+  } catch (e) {
+    post({ type: "fatal", message: errorMessage(e) });
+  }
+});

@@ -1,0 +1,339 @@
+/**
+ * The Node host: loads a pipeline, runs its blocks in engine workers (one per `Worker:` name,
+ * "main" by default; the main thread never runs blocks), links cross-worker edges through SAB
+ * rings, writes logs, and merges telemetry. The CLI, the HTTP/WebSocket server and Electron all
+ * drive a pipeline through this class.
+ */
+import { existsSync, readFileSync } from "node:fs";
+import { dirname, join, resolve } from "node:path";
+import { fileURLToPath } from "node:url";
+import { Worker } from "node:worker_threads";
+import { catalog } from "../blocks/catalog";
+import { errorMessage, type Diagnostic } from "../engine/diagnostics";
+import { shapeSize } from "../engine/frame";
+import { loadPipeline } from "../engine/pipeline/loader";
+import type { Plan, RuntimeEvent, Telemetry } from "../engine/runtime/runtime";
+import { SabRing } from "../engine/runtime/sab-ring";
+import { LogWriter } from "./log-writer";
+import { takeTimeBase } from "./time-base";
+import type { ClockMode, ControlOp, HostToWorker, WorkerToHost } from "./worker-protocol";
+
+export interface HostOptions {
+  mode?: ClockMode;
+  /** Spin the last ~0.3 ms before each tick (lower jitter, more CPU). */
+  precision?: boolean;
+  /** Base folder for relative `Path` logs (default: the pipeline file's folder). */
+  logDir?: string;
+  /** Virtual clock start (UNIX seconds, default 0) and length (default: until the input ends). */
+  virtualStart?: number;
+  virtualDuration?: number;
+  telemetryHz?: number;
+  workerPath?: string;
+  wasmPath?: string;
+}
+
+export interface HostEvents {
+  telemetry?: (t: Telemetry) => void;
+  event?: (e: RuntimeEvent) => void;
+  finished?: () => void;
+  fatal?: (message: string) => void;
+}
+
+function repoRootFrom(here: string): string {
+  let d = dirname(here);
+  for (let i = 0; i < 6; i++) {
+    if (existsSync(join(d, "package.json"))) return d;
+    d = dirname(d);
+  }
+  return dirname(here);
+}
+
+/** dist/engine.worker.mjs next to the bundle, or the repo's dist when running from sources. */
+export function defaultWorkerPath(): string {
+  const here = fileURLToPath(import.meta.url);
+  if (here.endsWith(".mjs")) return join(dirname(here), "engine.worker.mjs");
+  return join(repoRootFrom(here), "dist", "engine.worker.mjs");
+}
+
+export function defaultWasmPath(): string {
+  const here = fileURLToPath(import.meta.url);
+  const nextTo = join(dirname(here), "mosaic_core_bg.wasm");
+  if (here.endsWith(".mjs") && existsSync(nextTo)) return nextTo;
+  const root = repoRootFrom(here);
+  const dist = join(root, "dist", "mosaic_core_bg.wasm");
+  return existsSync(dist) ? dist : join(root, "core-wasm", "pkg", "mosaic_core_bg.wasm");
+}
+
+interface WorkerState {
+  name: string;
+  worker: Worker;
+  doorbell?: SharedArrayBuffer;
+  telemetry?: Telemetry;
+  stopped: boolean;
+  exited: boolean;
+  waiters: ((m: WorkerToHost) => boolean)[];
+}
+
+export interface LoadOutcome {
+  host: Host | undefined;
+  diagnostics: Diagnostic[];
+}
+
+export class Host {
+  private readonly workers = new Map<string, WorkerState>();
+  private readonly logWriter: LogWriter;
+  private readonly replies = new Map<number, (r: { ok: boolean; message: string }) => void>();
+  private nextReply = 0;
+  private finishedWorkers = new Set<string>();
+  private stopping: Promise<Telemetry> | undefined;
+  events: HostEvents = {};
+  plan: Plan | undefined;
+  readonly startedAt = Date.now();
+
+  private constructor(
+    readonly file: string,
+    readonly options: Required<Omit<HostOptions, "logDir">> & { logDir: string },
+  ) {
+    this.logWriter = new LogWriter(options.logDir, {
+      onError: (file, message) =>
+        this.events.event?.({ t: Date.now() / 1000, level: "error", block: file, message }),
+    }, options.mode === "virtual" ? 20 : 100);
+  }
+
+  /** Loads and instantiates a pipeline file; on failure returns its diagnostics and no host. */
+  static async load(file: string, opts: HostOptions = {}, events: HostEvents = {}): Promise<LoadOutcome> {
+    const full = resolve(file);
+    let source: string;
+    try {
+      source = readFileSync(full, "utf8");
+    } catch (e) {
+      const code = (e as NodeJS.ErrnoException).code;
+      return {
+        host: undefined,
+        diagnostics: [
+          {
+            severity: "error",
+            code: "file",
+            message: code === "ENOENT" ? "no such file" : `cannot read the file: ${errorMessage(e)}`,
+            file,
+            line: 0,
+            col: 0,
+          },
+        ],
+      };
+    }
+    const loaded = loadPipeline(source, file, catalog);
+    if (!loaded.spec) return { host: undefined, diagnostics: loaded.diagnostics };
+    const mode = opts.mode ?? "realtime";
+    const host = new Host(file, {
+      mode,
+      precision: opts.precision ?? false,
+      logDir: opts.logDir ?? dirname(full),
+      virtualStart: opts.virtualStart ?? 0,
+      virtualDuration: opts.virtualDuration ?? Infinity,
+      telemetryHz: opts.telemetryHz ?? 20,
+      workerPath: opts.workerPath ?? defaultWorkerPath(),
+      wasmPath: opts.wasmPath ?? defaultWasmPath(),
+    });
+    host.events = events;
+    const timeBase = takeTimeBase();
+    const names = mode === "virtual" ? ["main"] : ["main", ...new Set(loaded.spec.blocks.map((b) => b.worker).filter((w) => w !== "main"))];
+    const diagnostics: Diagnostic[] = [];
+    const init = (name: string, plan?: Plan) => ({
+      type: "init" as const,
+      file: full,
+      source,
+      worker: name,
+      mode,
+      timeBase,
+      virtualStart: host.options.virtualStart,
+      virtualDuration: host.options.virtualDuration,
+      wasmPath: host.options.wasmPath,
+      ...(plan ? { plan } : {}),
+      precision: host.options.precision,
+      telemetryHz: host.options.telemetryHz,
+    });
+    // The main worker instantiates everything once to learn shapes and rates (the plan).
+    const main = host.spawn("main");
+    const first = await host.request(main, init("main"), (m) => m.type === "created" || m.type === "failed" || m.type === "fatal");
+    const fail = async (d: Diagnostic[]) => {
+      await host.terminateAll();
+      return { host: undefined, diagnostics: [...diagnostics, ...d] };
+    };
+    if (first.type === "fatal") return fail([{ severity: "error", code: "fatal", message: first.message, file, line: 0, col: 0 }]);
+    if (first.type !== "created") return fail(first.type === "failed" ? first.diagnostics : []);
+    diagnostics.push(...first.diagnostics);
+    main.doorbell = first.doorbell;
+    host.plan = first.plan;
+    for (const name of names.slice(1)) {
+      const w = host.spawn(name);
+      const r = await host.request(w, init(name, first.plan), (m) => m.type === "created" || m.type === "failed" || m.type === "fatal");
+      if (r.type === "fatal") return fail([{ severity: "error", code: "fatal", message: r.message, file, line: 0, col: 0 }]);
+      if (r.type !== "created") return fail(r.type === "failed" ? r.diagnostics : []);
+      w.doorbell = r.doorbell;
+    }
+    host.linkWorkers(loaded.spec.blocks.map((b) => ({ name: b.name, worker: b.worker, inputs: b.inputs, capacity: b.queue.capacity })));
+    return { host, diagnostics };
+  }
+
+  private spawn(name: string): WorkerState {
+    const worker = new Worker(this.options.workerPath, { name: `mosaic-engine-${name}` });
+    const st: WorkerState = { name, worker, stopped: false, exited: false, waiters: [] };
+    this.workers.set(name, st);
+    worker.on("message", (m: WorkerToHost) => this.onMessage(st, m));
+    worker.on("error", (e) => {
+      this.events.fatal?.(`engine worker '${name}' crashed: ${errorMessage(e)}`);
+    });
+    worker.on("exit", (code) => {
+      st.exited = true;
+      if (!st.stopped && code !== 0) this.events.fatal?.(`engine worker '${name}' exited with code ${code}`);
+      for (const w of st.waiters.splice(0)) w({ type: "fatal", message: `worker '${name}' exited (${code})` });
+    });
+    return st;
+  }
+
+  private request(st: WorkerState, msg: HostToWorker, until: (m: WorkerToHost) => boolean): Promise<WorkerToHost> {
+    return new Promise((res) => {
+      st.waiters.push((m) => {
+        if (until(m)) {
+          res(m);
+          return true;
+        }
+        return false;
+      });
+      st.worker.postMessage(msg);
+    });
+  }
+
+  private onMessage(st: WorkerState, m: WorkerToHost): void {
+    st.waiters = st.waiters.filter((w) => !w(m));
+    switch (m.type) {
+      case "log-open":
+        this.logWriter.open(`${st.name}:${m.id}`, m.block, m.port, m.isDefaultPort, m.path, m.shape, m.ring);
+        break;
+      case "log-close":
+        this.logWriter.close(`${st.name}:${m.id}`);
+        break;
+      case "telemetry":
+      case "finished":
+      case "stopped":
+        st.telemetry = m.telemetry;
+        for (const e of m.telemetry.events) this.events.event?.(e);
+        m.telemetry.events = [];
+        this.events.telemetry?.(this.telemetry());
+        if (m.type === "finished") {
+          this.finishedWorkers.add(st.name);
+          if (st.name === "main" || this.finishedWorkers.size === this.workers.size) this.events.finished?.();
+        }
+        break;
+      case "reply": {
+        const r = this.replies.get(m.id);
+        this.replies.delete(m.id);
+        r?.({ ok: m.ok, message: m.message });
+        break;
+      }
+      case "fatal":
+        this.events.fatal?.(`engine worker '${st.name}': ${m.message}`);
+        break;
+      default:
+        break;
+    }
+  }
+
+  /** Creates a SAB ring for every edge whose ends live on different workers. */
+  private linkWorkers(blocks: { name: string; worker: string; inputs: { block: string; port: string }[]; capacity: number | undefined }[]): void {
+    if (this.workers.size < 2 || !this.plan) return;
+    const planOf = new Map(this.plan.blocks.map((b) => [b.name, b]));
+    const links = new Map<string, { outs: unknown[]; ins: unknown[] }>();
+    const get = (w: string) => {
+      let l = links.get(w);
+      if (!l) links.set(w, (l = { outs: [], ins: [] }));
+      return l;
+    };
+    for (const b of blocks) {
+      b.inputs.forEach((inp, index) => {
+        const src = planOf.get(inp.block);
+        if (!src || src.worker === b.worker) return;
+        const shape = src.outputs.find((o) => o.name === inp.port)?.shape ?? { rows: 1, cols: 0 };
+        const capacity = b.capacity ?? Math.max(256, Math.ceil(src.desiredRate));
+        const ring = SabRing.allocate(capacity, shapeSize(shape));
+        const consumer = this.workers.get(b.worker)!;
+        get(src.worker).outs.push({ block: inp.block, port: inp.port, ring, bell: consumer.doorbell! });
+        get(b.worker).ins.push({ block: b.name, index, ring });
+      });
+    }
+    for (const [w, l] of links) {
+      this.workers.get(w)!.worker.postMessage({ type: "link", outs: l.outs, ins: l.ins } as HostToWorker);
+    }
+  }
+
+  start(): void {
+    for (const w of this.workers.values()) w.worker.postMessage({ type: "start" } satisfies HostToWorker);
+  }
+
+  /** Merged telemetry of all workers (latest of each). */
+  telemetry(): Telemetry {
+    const parts = [...this.workers.values()].map((w) => w.telemetry).filter((t): t is Telemetry => !!t);
+    return {
+      t: Math.max(0, ...parts.map((p) => p.t)),
+      worker: "*",
+      blocks: parts.flatMap((p) => p.blocks),
+      edges: parts.flatMap((p) => p.edges),
+      events: [],
+      finished: parts.length > 0 && parts.every((p) => p.finished),
+    };
+  }
+
+  /** Sends a control request to the worker that runs `block` (or to all for resetTiming). */
+  control(op: ControlOp): Promise<{ ok: boolean; message: string }> {
+    const targets =
+      op.op === "resetTiming"
+        ? [...this.workers.values()]
+        : [this.workers.get(this.plan?.blocks.find((b) => b.name === op.block)?.worker ?? "main")!];
+    return Promise.all(
+      targets.map(
+        (w) =>
+          new Promise<{ ok: boolean; message: string }>((res) => {
+            const id = this.nextReply++;
+            this.replies.set(id, res);
+            w.worker.postMessage({ type: "control", id, ...op } as HostToWorker);
+          }),
+      ),
+    ).then((rs) => ({ ok: rs.every((r) => r.ok), message: rs.map((r) => r.message).join("; ") }));
+  }
+
+  /** Stops every worker, waits for their final telemetry, flushes and closes the logs. */
+  stop(timeoutMs = 5000): Promise<Telemetry> {
+    if (this.stopping) return this.stopping;
+    this.stopping = (async () => {
+      await Promise.all(
+        [...this.workers.values()].map((w) => {
+          w.stopped = true;
+          if (w.exited) return Promise.resolve();
+          return Promise.race([
+            this.request(w, { type: "stop" }, (m) => m.type === "stopped" || m.type === "fatal"),
+            new Promise((r) => setTimeout(r, timeoutMs)),
+          ]);
+        }),
+      );
+      this.logWriter.closeAll();
+      const t = this.telemetry();
+      await this.terminateAll();
+      return t;
+    })();
+    return this.stopping;
+  }
+
+  private async terminateAll(): Promise<void> {
+    await Promise.all(
+      [...this.workers.values()].map(async (w) => {
+        w.stopped = true;
+        if (!w.exited) await w.worker.terminate();
+      }),
+    );
+  }
+
+  get logFiles(): string[] {
+    return this.logWriter.files;
+  }
+}

@@ -1,0 +1,63 @@
+/** Messages between the host (main thread) and its engine workers. */
+import type { Diagnostic } from "../engine/diagnostics";
+import type { Shape } from "../engine/frame";
+import type { Plan, Telemetry } from "../engine/runtime/runtime";
+import type { SabRingInit } from "../engine/runtime/sab-ring";
+import type { TimeBase } from "./time-base";
+
+export type ClockMode = "realtime" | "virtual";
+
+export interface InitMessage {
+  type: "init";
+  file: string;
+  source: string;
+  worker: string;
+  mode: ClockMode;
+  timeBase: TimeBase;
+  /** Virtual clock start, UNIX seconds. */
+  virtualStart: number;
+  /** Virtual clock: stop at start + duration (Infinity = until sources finish). */
+  virtualDuration: number;
+  wasmPath: string;
+  plan?: Plan;
+  precision: boolean;
+  telemetryHz: number;
+}
+
+export interface LinkMessage {
+  type: "link";
+  outs: { block: string; port: string; ring: SabRingInit; bell: SharedArrayBuffer }[];
+  ins: { block: string; index: number; ring: SabRingInit }[];
+}
+
+export type ControlOp =
+  | { op: "invoke"; block: string; action: string; arg?: unknown }
+  | { op: "setParam"; block: string; param: string; value: unknown }
+  | { op: "resetTiming" };
+
+export type HostToWorker =
+  | InitMessage
+  | LinkMessage
+  | { type: "start" }
+  | { type: "stop" }
+  | ({ type: "control"; id: number } & ControlOp);
+
+export type WorkerToHost =
+  | { type: "created"; plan: Plan; diagnostics: Diagnostic[]; doorbell: SharedArrayBuffer }
+  | { type: "failed"; diagnostics: Diagnostic[] }
+  | {
+      type: "log-open";
+      id: number;
+      block: string;
+      port: string;
+      isDefaultPort: boolean;
+      path: string;
+      shape: Shape;
+      ring: SabRingInit;
+    }
+  | { type: "log-close"; id: number }
+  | { type: "telemetry"; telemetry: Telemetry }
+  | { type: "reply"; id: number; ok: boolean; message: string }
+  | { type: "finished"; telemetry: Telemetry }
+  | { type: "stopped"; telemetry: Telemetry }
+  | { type: "fatal"; message: string };

@@ -1,0 +1,13 @@
+import { defineConfig } from "vitest/config";
+
+export default defineConfig({
+  test: {
+    include: ["app/**/*.test.ts", "native-bridges/**/*.test.ts", "tests/**/*.test.ts"],
+    exclude: ["**/node_modules/**", "dist/**", "core-wasm/**"],
+    testTimeout: 30_000,
+    hookTimeout: 60_000,
+    pool: "forks",
+    // Two cores: keep the run predictable.
+    maxWorkers: 2,
+  },
+});
