@@ -5,7 +5,9 @@ import { fileURLToPath, pathToFileURL } from "node:url";
 
 const cli = fileURLToPath(new URL("../dist/cli.mjs", import.meta.url));
 if (!existsSync(cli)) {
-  process.stderr.write("mosaic: dist/cli.mjs is missing; run `npm run build` (or `npm test` / `npm start`) first\n");
+  process.stderr.write(
+    "mosaic: dist/cli.mjs is missing; run `npm run build` (or `npm test` / `npm start`) first\n",
+  );
   process.exit(1);
 }
 await import(pathToFileURL(cli).href);

@@ -28,7 +28,9 @@ await build({
   logLevel: "warning",
   // Packages stay in node_modules (native modules cannot be bundled; keeps dist small).
   packages: "external",
-  banner: { js: "import { createRequire as __cr } from 'node:module'; const require = __cr(import.meta.url);" },
+  banner: {
+    js: "import { createRequire as __cr } from 'node:module'; const require = __cr(import.meta.url);",
+  },
 });
 
 const wasm = join(root, "core-wasm/pkg/mosaic_core_bg.wasm");

@@ -23,7 +23,7 @@ Usage:
       Checks pipeline files (YAML syntax, block types, params, wiring, shapes, files they read).
       Exit 0 when every file is valid, 2 otherwise; messages are file:line:col.
   mosaic run FILE [--duration S] [--clock realtime|virtual] [--json] [--precision]
-                  [--log-dir DIR] [--start T]
+                  [--log-dir DIR] [--start T] [--warmup S]
       Runs a pipeline and shows a live per-block table: desired and actual rate, status
       (on time, lagging, stumbling, idle), compute time and drops. --json prints one JSON object
       per line instead (telemetry at 20 Hz, events, a final summary). Ctrl-C stops cleanly and
@@ -33,6 +33,7 @@ Usage:
         --precision    spin the last ~0.3 ms before each tick (less jitter, more CPU)
         --log-dir DIR  base folder for relative Path logs (default: the pipeline's folder)
         --start T      virtual clock start time, UNIX seconds (default 0)
+        --warmup S     reset the timing statistics (ΔT, lateness) after S seconds
   mosaic bench [--duration S] [--only NAME[,NAME]] [--out DIR]
       Runs the standard benchmarks and writes bench/results/*.json and *.md.
   mosaic --help | --version
@@ -89,6 +90,7 @@ async function cmdRun(args: string[]): Promise<number> {
       precision: { type: "boolean", default: false },
       "log-dir": { type: "string" },
       start: { type: "string" },
+      warmup: { type: "string" },
     },
   });
   const file = positionals[0];
@@ -109,6 +111,11 @@ async function cmdRun(args: string[]): Promise<number> {
   const start = values.start !== undefined ? Number(values.start) : 0;
   if (!Number.isFinite(start)) {
     err(`mosaic run: --start must be a number of seconds, not '${values.start}'`);
+    return 2;
+  }
+  const warmup = values.warmup !== undefined ? Number(values.warmup) : 0;
+  if (!(warmup >= 0)) {
+    err(`mosaic run: --warmup must be a number of seconds, not '${values.warmup}'`);
     return 2;
   }
   const json = values.json;
@@ -171,9 +178,25 @@ async function cmdRun(args: string[]): Promise<number> {
   process.once("SIGINT", onSig);
   process.once("SIGTERM", onSig);
   const redraw = tty ? setInterval(draw, 250) : undefined;
-  const timer = mode === "realtime" && duration !== undefined ? setTimeout(() => resolveDone("duration"), duration * 1000) : undefined;
+  const timer =
+    mode === "realtime" && duration !== undefined
+      ? setTimeout(() => resolveDone("duration"), duration * 1000)
+      : undefined;
+  const t0 = performance.now();
+  let measuredFrom = t0;
+  const warm =
+    warmup > 0
+      ? setTimeout(() => {
+          measuredFrom = performance.now();
+          void host.control({ op: "resetTiming" });
+          if (json) out(JSON.stringify({ type: "warmup-done", t: Date.now() / 1000 }));
+        }, warmup * 1000)
+      : undefined;
   host.start();
   const reason = await done;
+  const wallSeconds = (performance.now() - t0) / 1000;
+  const measuredSeconds = (performance.now() - measuredFrom) / 1000;
+  if (warm) clearTimeout(warm);
   if (timer) clearTimeout(timer);
   if (redraw) clearInterval(redraw);
   process.off("SIGINT", onSig);
@@ -182,7 +205,17 @@ async function cmdRun(args: string[]): Promise<number> {
   latest = final;
   const code = fatal ? 1 : blockErrors > 0 ? 1 : 0;
   if (json) {
-    out(JSON.stringify({ type: "summary", reason, exitCode: code, logs: host.logFiles, ...final }));
+    out(
+      JSON.stringify({
+        type: "summary",
+        reason,
+        exitCode: code,
+        wallSeconds,
+        measuredSeconds,
+        logs: host.logFiles,
+        ...final,
+      }),
+    );
   } else {
     if (tty) draw();
     else for (const l of renderTable(final, { color: false })) out(l);
@@ -197,7 +230,9 @@ async function cmdRun(args: string[]): Promise<number> {
           : reason === "interrupted"
             ? "interrupted"
             : "failed";
-    out(`stopped: ${why}${blockErrors ? `; ${blockErrors} block error${blockErrors === 1 ? "" : "s"} (see above)` : ""}`);
+    out(
+      `stopped: ${why}${blockErrors ? `; ${blockErrors} block error${blockErrors === 1 ? "" : "s"} (see above)` : ""}`,
+    );
   }
   return code;
 }

@@ -6,7 +6,7 @@ main(process.argv.slice(2)).then(
     process.exitCode = code;
   },
   (e: unknown) => {
-    err(`mosaic: ${(e as Error).stack ?? String(e)}`);
+    process.stderr.write(`mosaic: ${(e as Error).stack ?? String(e)}\n`);
     process.exitCode = 1;
   },
 );

@@ -29,9 +29,10 @@ function fmtRate(hz: number): string {
 
 function fmtMs(ms: number): string {
   if (!(ms > 0)) return "0";
-  if (ms < 0.01) return `${(ms * 1000).toFixed(1)}µs`;
-  if (ms < 10) return `${ms.toFixed(3)}`;
-  return ms.toFixed(1);
+  if (ms < 0.01) return `${(ms * 1000).toFixed(1)} µs`;
+  if (ms < 1) return `${Math.round(ms * 1000)} µs`;
+  if (ms < 100) return `${ms.toFixed(2)} ms`;
+  return `${Math.round(ms)} ms`;
 }
 
 function pad(s: string, w: number, right = false): string {
@@ -46,7 +47,16 @@ export interface TableOptions {
 }
 
 export function renderTable(t: Telemetry, o: TableOptions): string[] {
-  const header = ["block", "type", "desired Hz", "actual Hz", "status", "compute ms (mean/max)", "drops", ""];
+  const header = [
+    "block",
+    "type",
+    "desired Hz",
+    "actual Hz",
+    "status",
+    "compute (mean / max)",
+    "drops",
+    "",
+  ];
   const rows = t.blocks.map((b) => [
     b.worker === "main" ? b.name : `${b.name} @${b.worker}`,
     b.type,
@@ -63,7 +73,9 @@ export function renderTable(t: Telemetry, o: TableOptions): string[] {
       .filter((s) => s !== "")
       .join("; "),
   ]);
-  const widths = header.map((h, i) => Math.max([...h].length, ...rows.map((r) => [...r[i]!].length)));
+  const widths = header.map((h, i) =>
+    Math.max([...h].length, ...rows.map((r) => [...r[i]!].length)),
+  );
   const right = [false, false, true, true, false, true, true, false];
   const line = (cells: string[], status?: Status): string => {
     const padded = cells.map((c, i) => pad(c, widths[i]!, right[i]));

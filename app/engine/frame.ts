@@ -115,7 +115,9 @@ export class Frame {
       f.t[i] = t[i]!;
       const row = values[i] ?? [];
       if (row.length !== s) {
-        throw new Error(`event ${i} has ${row.length} values; shape ${formatShape(shape)} needs ${s}`);
+        throw new Error(
+          `event ${i} has ${row.length} values; shape ${formatShape(shape)} needs ${s}`,
+        );
       }
       for (let k = 0; k < s; k++) f.v[i * s + k] = row[k]!;
     }

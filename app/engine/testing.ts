@@ -2,7 +2,15 @@
  * Test helpers (Node-RED style: load a tiny flow, feed it, look at what comes out; Timeflux style:
  * set a block's input, call it, check its output). Used by block tests and integration tests.
  */
-import type { AnyBlockDefinition, BlockContext, BlockInstance, InputInfo, OutputPort, Resources, TimerHandle } from "./block";
+import type {
+  AnyBlockDefinition,
+  BlockContext,
+  BlockInstance,
+  InputInfo,
+  OutputPort,
+  Resources,
+  TimerHandle,
+} from "./block";
 import type { Catalog } from "./catalog";
 import { VirtualClock } from "./clock";
 import { formatDiagnostic, type Diagnostic } from "./diagnostics";
@@ -55,7 +63,10 @@ export interface VirtualRun {
 }
 
 /** Loads `yaml`, runs it under the virtual clock and records every block's output. Throws on load errors. */
-export async function runVirtualPipeline(yaml: string, opts: VirtualRunOptions): Promise<VirtualRun> {
+export async function runVirtualPipeline(
+  yaml: string,
+  opts: VirtualRunOptions,
+): Promise<VirtualRun> {
   const file = opts.file ?? "test.yaml";
   const loaded = loadPipeline(yaml, file, opts.catalog);
   if (!loaded.spec) throw new Error(loaded.diagnostics.map(formatDiagnostic).join("\n"));
@@ -85,7 +96,13 @@ export async function runVirtualPipeline(yaml: string, opts: VirtualRunOptions):
   runVirtual(rt, clock, clock.t + opts.duration);
   const telemetry = rt.telemetry();
   rt.dispose();
-  return { outputs, telemetry, logs, runtime: rt, diagnostics: [...loaded.diagnostics, ...created.diagnostics] };
+  return {
+    outputs,
+    telemetry,
+    logs,
+    runtime: rt,
+    diagnostics: [...loaded.diagnostics, ...created.diagnostics],
+  };
 }
 
 export interface HarnessOptions {
@@ -122,10 +139,17 @@ export class BlockHarness {
     this.desiredRate = opts.desiredRate ?? opts.inputs?.find((i) => (i.rate ?? 0) > 0)?.rate ?? 0;
   }
 
-  static async create(def: AnyBlockDefinition, rawParams: unknown, opts: HarnessOptions = {}): Promise<BlockHarness> {
+  static async create(
+    def: AnyBlockDefinition,
+    rawParams: unknown,
+    opts: HarnessOptions = {},
+  ): Promise<BlockHarness> {
     const h = new BlockHarness(def, opts);
     const parsed = def.params.safeParse(rawParams ?? {});
-    if (!parsed.success) throw new Error(`invalid params: ${parsed.error.issues.map((i: { path: PropertyKey[]; message: string }) => `${i.path.map(String).join(".")}: ${i.message}`).join("; ")}`);
+    if (!parsed.success)
+      throw new Error(
+        `invalid params: ${parsed.error.issues.map((i: { path: PropertyKey[]; message: string }) => `${i.path.map(String).join(".")}: ${i.message}`).join("; ")}`,
+      );
     h.params = parsed.data;
     h.instance = await def.create(h.context(), parsed.data);
     return h;

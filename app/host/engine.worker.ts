@@ -39,7 +39,13 @@ const logRings: SabRing[] = [];
 function sabLogSink(virtual: boolean): LogSink {
   let nextId = 0;
   return {
-    open(block: string, portName: string, isDefaultPort: boolean, path: string, shape: Shape): LogChannel {
+    open(
+      block: string,
+      portName: string,
+      isDefaultPort: boolean,
+      path: string,
+      shape: Shape,
+    ): LogChannel {
       const id = nextId++;
       const stride = shape.rows * shape.cols;
       // About two seconds of data at 2 kHz for small vectors, at least 1 MiB of doubles.
@@ -67,7 +73,10 @@ async function create(msg: InitMessage): Promise<void> {
   try {
     initDsp(readFileSync(msg.wasmPath));
   } catch (e) {
-    post({ type: "fatal", message: `cannot load the DSP core (${msg.wasmPath}): ${errorMessage(e)}` });
+    post({
+      type: "fatal",
+      message: `cannot load the DSP core (${msg.wasmPath}): ${errorMessage(e)}`,
+    });
     return;
   }
   const loaded = loadPipeline(msg.source, msg.file, catalog);
@@ -166,7 +175,17 @@ function stop(): void {
     rt.dispose();
     post({ type: "stopped", telemetry });
   } else {
-    post({ type: "stopped", telemetry: { t: 0, worker: init?.worker ?? "main", blocks: [], edges: [], events: [], finished: false } });
+    post({
+      type: "stopped",
+      telemetry: {
+        t: 0,
+        worker: init?.worker ?? "main",
+        blocks: [],
+        edges: [],
+        events: [],
+        finished: false,
+      },
+    });
   }
 }
 

@@ -94,14 +94,22 @@ export class Host {
     readonly file: string,
     readonly options: Required<Omit<HostOptions, "logDir">> & { logDir: string },
   ) {
-    this.logWriter = new LogWriter(options.logDir, {
-      onError: (file, message) =>
-        this.events.event?.({ t: Date.now() / 1000, level: "error", block: file, message }),
-    }, options.mode === "virtual" ? 20 : 100);
+    this.logWriter = new LogWriter(
+      options.logDir,
+      {
+        onError: (file, message) =>
+          this.events.event?.({ t: Date.now() / 1000, level: "error", block: file, message }),
+      },
+      options.mode === "virtual" ? 20 : 100,
+    );
   }
 
   /** Loads and instantiates a pipeline file; on failure returns its diagnostics and no host. */
-  static async load(file: string, opts: HostOptions = {}, events: HostEvents = {}): Promise<LoadOutcome> {
+  static async load(
+    file: string,
+    opts: HostOptions = {},
+    events: HostEvents = {},
+  ): Promise<LoadOutcome> {
     const full = resolve(file);
     let source: string;
     try {
@@ -114,7 +122,8 @@ export class Host {
           {
             severity: "error",
             code: "file",
-            message: code === "ENOENT" ? "no such file" : `cannot read the file: ${errorMessage(e)}`,
+            message:
+              code === "ENOENT" ? "no such file" : `cannot read the file: ${errorMessage(e)}`,
             file,
             line: 0,
             col: 0,
@@ -137,7 +146,10 @@ export class Host {
     });
     host.events = events;
     const timeBase = takeTimeBase();
-    const names = mode === "virtual" ? ["main"] : ["main", ...new Set(loaded.spec.blocks.map((b) => b.worker).filter((w) => w !== "main"))];
+    const names =
+      mode === "virtual"
+        ? ["main"]
+        : ["main", ...new Set(loaded.spec.blocks.map((b) => b.worker).filter((w) => w !== "main"))];
     const diagnostics: Diagnostic[] = [];
     const init = (name: string, plan?: Plan) => ({
       type: "init" as const,
@@ -155,24 +167,45 @@ export class Host {
     });
     // The main worker instantiates everything once to learn shapes and rates (the plan).
     const main = host.spawn("main");
-    const first = await host.request(main, init("main"), (m) => m.type === "created" || m.type === "failed" || m.type === "fatal");
+    const first = await host.request(
+      main,
+      init("main"),
+      (m) => m.type === "created" || m.type === "failed" || m.type === "fatal",
+    );
     const fail = async (d: Diagnostic[]) => {
       await host.terminateAll();
       return { host: undefined, diagnostics: [...diagnostics, ...d] };
     };
-    if (first.type === "fatal") return fail([{ severity: "error", code: "fatal", message: first.message, file, line: 0, col: 0 }]);
+    if (first.type === "fatal")
+      return fail([
+        { severity: "error", code: "fatal", message: first.message, file, line: 0, col: 0 },
+      ]);
     if (first.type !== "created") return fail(first.type === "failed" ? first.diagnostics : []);
     diagnostics.push(...first.diagnostics);
     main.doorbell = first.doorbell;
     host.plan = first.plan;
     for (const name of names.slice(1)) {
       const w = host.spawn(name);
-      const r = await host.request(w, init(name, first.plan), (m) => m.type === "created" || m.type === "failed" || m.type === "fatal");
-      if (r.type === "fatal") return fail([{ severity: "error", code: "fatal", message: r.message, file, line: 0, col: 0 }]);
+      const r = await host.request(
+        w,
+        init(name, first.plan),
+        (m) => m.type === "created" || m.type === "failed" || m.type === "fatal",
+      );
+      if (r.type === "fatal")
+        return fail([
+          { severity: "error", code: "fatal", message: r.message, file, line: 0, col: 0 },
+        ]);
       if (r.type !== "created") return fail(r.type === "failed" ? r.diagnostics : []);
       w.doorbell = r.doorbell;
     }
-    host.linkWorkers(loaded.spec.blocks.map((b) => ({ name: b.name, worker: b.worker, inputs: b.inputs, capacity: b.queue.capacity })));
+    host.linkWorkers(
+      loaded.spec.blocks.map((b) => ({
+        name: b.name,
+        worker: b.worker,
+        inputs: b.inputs,
+        capacity: b.queue.capacity,
+      })),
+    );
     return { host, diagnostics };
   }
 
@@ -186,13 +219,19 @@ export class Host {
     });
     worker.on("exit", (code) => {
       st.exited = true;
-      if (!st.stopped && code !== 0) this.events.fatal?.(`engine worker '${name}' exited with code ${code}`);
-      for (const w of st.waiters.splice(0)) w({ type: "fatal", message: `worker '${name}' exited (${code})` });
+      if (!st.stopped && code !== 0)
+        this.events.fatal?.(`engine worker '${name}' exited with code ${code}`);
+      for (const w of st.waiters.splice(0))
+        w({ type: "fatal", message: `worker '${name}' exited (${code})` });
     });
     return st;
   }
 
-  private request(st: WorkerState, msg: HostToWorker, until: (m: WorkerToHost) => boolean): Promise<WorkerToHost> {
+  private request(
+    st: WorkerState,
+    msg: HostToWorker,
+    until: (m: WorkerToHost) => boolean,
+  ): Promise<WorkerToHost> {
     return new Promise((res) => {
       st.waiters.push((m) => {
         if (until(m)) {
@@ -209,7 +248,15 @@ export class Host {
     st.waiters = st.waiters.filter((w) => !w(m));
     switch (m.type) {
       case "log-open":
-        this.logWriter.open(`${st.name}:${m.id}`, m.block, m.port, m.isDefaultPort, m.path, m.shape, m.ring);
+        this.logWriter.open(
+          `${st.name}:${m.id}`,
+          m.block,
+          m.port,
+          m.isDefaultPort,
+          m.path,
+          m.shape,
+          m.ring,
+        );
         break;
       case "log-close":
         this.logWriter.close(`${st.name}:${m.id}`);
@@ -223,7 +270,8 @@ export class Host {
         this.events.telemetry?.(this.telemetry());
         if (m.type === "finished") {
           this.finishedWorkers.add(st.name);
-          if (st.name === "main" || this.finishedWorkers.size === this.workers.size) this.events.finished?.();
+          if (st.name === "main" || this.finishedWorkers.size === this.workers.size)
+            this.events.finished?.();
         }
         break;
       case "reply": {
@@ -241,7 +289,14 @@ export class Host {
   }
 
   /** Creates a SAB ring for every edge whose ends live on different workers. */
-  private linkWorkers(blocks: { name: string; worker: string; inputs: { block: string; port: string }[]; capacity: number | undefined }[]): void {
+  private linkWorkers(
+    blocks: {
+      name: string;
+      worker: string;
+      inputs: { block: string; port: string }[];
+      capacity: number | undefined;
+    }[],
+  ): void {
     if (this.workers.size < 2 || !this.plan) return;
     const planOf = new Map(this.plan.blocks.map((b) => [b.name, b]));
     const links = new Map<string, { outs: unknown[]; ins: unknown[] }>();
@@ -258,22 +313,32 @@ export class Host {
         const capacity = b.capacity ?? Math.max(256, Math.ceil(src.desiredRate));
         const ring = SabRing.allocate(capacity, shapeSize(shape));
         const consumer = this.workers.get(b.worker)!;
-        get(src.worker).outs.push({ block: inp.block, port: inp.port, ring, bell: consumer.doorbell! });
+        get(src.worker).outs.push({
+          block: inp.block,
+          port: inp.port,
+          ring,
+          bell: consumer.doorbell!,
+        });
         get(b.worker).ins.push({ block: b.name, index, ring });
       });
     }
     for (const [w, l] of links) {
-      this.workers.get(w)!.worker.postMessage({ type: "link", outs: l.outs, ins: l.ins } as HostToWorker);
+      this.workers
+        .get(w)!
+        .worker.postMessage({ type: "link", outs: l.outs, ins: l.ins } as HostToWorker);
     }
   }
 
   start(): void {
-    for (const w of this.workers.values()) w.worker.postMessage({ type: "start" } satisfies HostToWorker);
+    for (const w of this.workers.values())
+      w.worker.postMessage({ type: "start" } satisfies HostToWorker);
   }
 
   /** Merged telemetry of all workers (latest of each). */
   telemetry(): Telemetry {
-    const parts = [...this.workers.values()].map((w) => w.telemetry).filter((t): t is Telemetry => !!t);
+    const parts = [...this.workers.values()]
+      .map((w) => w.telemetry)
+      .filter((t): t is Telemetry => !!t);
     return {
       t: Math.max(0, ...parts.map((p) => p.t)),
       worker: "*",

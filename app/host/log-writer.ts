@@ -35,17 +35,29 @@ export class LogWriter {
     private readonly intervalMs = 100,
   ) {}
 
+  private readonly opened: string[] = [];
+
+  /** Every file opened so far (also after closing). */
   get files(): string[] {
-    return [...this.logs.values()].map((l) => l.file);
+    return [...this.opened];
   }
 
   /** Opens (truncates) the file for one log ring. `key` must be unique per ring. */
-  open(key: string, block: string, port: string, isDefaultPort: boolean, path: string, shape: Shape, ring: SabRingInit): string {
+  open(
+    key: string,
+    block: string,
+    port: string,
+    isDefaultPort: boolean,
+    path: string,
+    shape: Shape,
+    ring: SabRingInit,
+  ): string {
     const rel = logFileName(path, block, port, isDefaultPort);
     const file = isAbsolute(rel) ? rel : resolve(this.baseDir, rel);
     try {
       mkdirSync(dirname(file), { recursive: true });
       const fd = openSync(file, "w");
+      this.opened.push(file);
       this.logs.set(key, {
         key,
         file,
@@ -108,7 +120,8 @@ export class LogWriter {
       const n = l.ring.read(f, 4096);
       if (n === 0) break;
       let chunk = "";
-      for (let i = 0; i < n; i++) chunk += formatLogLine(f.t[i]!, f.v, i * f.stride, f.stride) + "\n";
+      for (let i = 0; i < n; i++)
+        chunk += formatLogLine(f.t[i]!, f.v, i * f.stride, f.stride) + "\n";
       try {
         writeSync(l.fd, chunk);
         l.lines += n;

@@ -39,6 +39,7 @@ export function legacyPair(s: string): { key: string; value: string } {
 
 export function legacyInteger(s: string, what: string, param?: string): number {
   const v = legacyNumber(s, what, param);
-  if (!Number.isInteger(v)) throw new LegacyParamsError(`${what} '${s}' is not a whole number`, param);
+  if (!Number.isInteger(v))
+    throw new LegacyParamsError(`${what} '${s}' is not a whole number`, param);
   return v;
 }

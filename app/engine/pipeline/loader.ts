@@ -116,7 +116,15 @@ class Collector {
     message: string,
     extra: Partial<Diagnostic> = {},
   ): void {
-    this.list.push({ severity, code, message, file: this.file, line: at.line, col: at.col, ...extra });
+    this.list.push({
+      severity,
+      code,
+      message,
+      file: this.file,
+      line: at.line,
+      col: at.col,
+      ...extra,
+    });
   }
 
   error(code: string, at: SourcePos, message: string, extra: Partial<Diagnostic> = {}): void {
@@ -142,7 +150,8 @@ function describeValue(v: unknown): string {
   if (v === null || v === undefined) return "nothing";
   if (Array.isArray(v)) return "a list";
   if (typeof v === "object") return "a mapping";
-  if (typeof v === "string") return `the string ${JSON.stringify(v.length > 40 ? v.slice(0, 40) + "…" : v)}`;
+  if (typeof v === "string")
+    return `the string ${JSON.stringify(v.length > 40 ? v.slice(0, 40) + "…" : v)}`;
   return `${typeof v} ${String(v)}`;
 }
 
@@ -177,7 +186,8 @@ function pathText(path: readonly PropertyKey[]): string {
 
 function nodeAtPath(root: unknown, path: readonly PropertyKey[]): YamlNode | undefined {
   let node: unknown = root;
-  let last: YamlNode | undefined = isMap(root) || isSeq(root) || isScalar(root) ? (root as YamlNode) : undefined;
+  let last: YamlNode | undefined =
+    isMap(root) || isSeq(root) || isScalar(root) ? (root as YamlNode) : undefined;
   for (const seg of path) {
     if (isMap(node)) {
       const pair = node.items.find((p) => isPair(p) && scalarString(p.key) === String(seg));
@@ -253,7 +263,8 @@ function explainIssue(
       };
     }
     case "too_small": {
-      const what = issue.origin === "array" ? "items" : issue.origin === "string" ? "characters" : "";
+      const what =
+        issue.origin === "array" ? "items" : issue.origin === "string" ? "characters" : "";
       const op = issue.inclusive === false ? "more than" : "at least";
       return {
         message: `is too small${input !== undefined ? ` (${describeValue(input)})` : ""}`,
@@ -261,7 +272,8 @@ function explainIssue(
       };
     }
     case "too_big": {
-      const what = issue.origin === "array" ? "items" : issue.origin === "string" ? "characters" : "";
+      const what =
+        issue.origin === "array" ? "items" : issue.origin === "string" ? "characters" : "";
       const op = issue.inclusive === false ? "less than" : "at most";
       return {
         message: `is too big${input !== undefined ? ` (${describeValue(input)})` : ""}`,
@@ -269,9 +281,15 @@ function explainIssue(
       };
     }
     case "not_multiple_of":
-      return { message: `has ${describeValue(input)}`, expected: `a multiple of ${String(issue.divisor)}` };
+      return {
+        message: `has ${describeValue(input)}`,
+        expected: `a multiple of ${String(issue.divisor)}`,
+      };
     case "invalid_union":
-      return { message: `has ${describeValue(input)}`, expected: "one of the allowed forms (see the block's docs)" };
+      return {
+        message: `has ${describeValue(input)}`,
+        expected: "one of the allowed forms (see the block's docs)",
+      };
     default:
       return { message: issue.message };
   }
@@ -290,19 +308,40 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
   if (doc.errors.length > 0) {
     // The first syntax error is the real one; later ones are usually its echoes.
     const e = doc.errors[0]!;
-    const p = lc.linePos(e.pos[0]);
+    let p: SourcePos = lc.linePos(e.pos[0]);
     const first = e.message.split("\n")[0] ?? e.message;
-    const msg =
-      e.code === "DUPLICATE_KEY"
-        ? `duplicate key: ${first.replace(/^Map keys must be unique/, "a block or key is defined twice")}`
-        : `YAML syntax error: ${first}`;
-    c.error(e.code === "DUPLICATE_KEY" ? "duplicate-key" : "yaml-syntax", { line: p.line, col: p.col }, msg);
+    let msg = `YAML syntax error: ${first}`;
+    if (e.code === "DUPLICATE_KEY") {
+      msg =
+        "duplicate key: a block (or a key inside one) is defined twice; the second definition is here";
+    } else if (e.code === "BLOCK_AS_IMPLICIT_KEY" || e.code === "MULTILINE_IMPLICIT_KEY") {
+      // The parser notices this on the line above the culprit: point at the over-indented line.
+      const lines = source.split(/\r?\n/);
+      const indent = (l: string) => l.length - l.trimStart().length;
+      const base = indent(lines[p.line - 1] ?? "");
+      for (let i = p.line; i < lines.length; i++) {
+        const l = lines[i]!;
+        if (l.trim() === "" || l.trimStart().startsWith("#")) continue;
+        if (indent(l) > base) p = { line: i + 1, col: indent(l) + 1 };
+        break;
+      }
+      msg =
+        "bad indentation: this line is indented further than the keys above it (the keys of one block must start in the same column)";
+    } else if (e.code === "BAD_INDENT") {
+      msg = `bad indentation: ${first}`;
+    }
+    c.error(
+      e.code === "DUPLICATE_KEY" ? "duplicate-key" : "yaml-syntax",
+      { line: p.line, col: p.col },
+      msg,
+    );
     return { spec: undefined, diagnostics: c.list, ok: false, doc };
   }
   const root = doc.contents;
   if (root === null || (isScalar(root) && (root.value === null || root.value === ""))) {
     c.error("empty", { line: 1, col: 1 }, "the pipeline is empty", {
-      expected: "a mapping from block names to blocks, e.g. `Timer: { Type: ScheduledTimer, DesiredRate: 200 }`",
+      expected:
+        "a mapping from block names to blocks, e.g. `Timer: { Type: ScheduledTimer, DesiredRate: 200 }`",
     });
     return { spec: undefined, diagnostics: c.list, ok: false, doc };
   }
@@ -322,22 +361,31 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
     const at = c.pos(keyNode);
     const name = scalarString(keyNode);
     if (name === undefined || name === "") {
-      c.error("bad-name", at, "a block name must be a plain word", { expected: "a name like `LowPass`" });
+      c.error("bad-name", at, "a block name must be a plain word", {
+        expected: "a name like `LowPass`",
+      });
       continue;
     }
     if (!BLOCK_NAME_RE.test(name)) {
       c.error("bad-name", at, `block name '${name}' is not valid`, {
         block: name,
-        expected: "letters, digits, '_' or '-', starting with a letter or '_' ('.' is reserved for ports)",
+        expected:
+          "letters, digits, '_' or '-', starting with a letter or '_' ('.' is reserved for ports)",
       });
       continue;
     }
     const value = pair.value;
     if (!isMap(value)) {
-      c.error("bad-block", c.pos((value as YamlNode | null) ?? keyNode), `block '${name}' is ${describeNode(value)}`, {
-        block: name,
-        expected: "a mapping with at least `Type`, e.g. `{ Type: Filter, Inputs: [Emg], Params: {...} }`",
-      });
+      c.error(
+        "bad-block",
+        c.pos((value as YamlNode | null) ?? keyNode),
+        `block '${name}' is ${describeNode(value)}`,
+        {
+          block: name,
+          expected:
+            "a mapping with at least `Type`, e.g. `{ Type: Filter, Inputs: [Emg], Params: {...} }`",
+        },
+      );
       continue;
     }
     const errorsBefore = c.errors;
@@ -369,19 +417,31 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
     } else {
       const t = scalarString(typeEntry.node);
       if (t === undefined || t === "") {
-        c.error("bad-type", c.pos(typeEntry.node as YamlNode), `block '${name}': Type is ${describeNode(typeEntry.node)}`, {
-          block: name,
-          expected: "the name of a block type",
-        });
+        c.error(
+          "bad-type",
+          c.pos(typeEntry.node as YamlNode),
+          `block '${name}': Type is ${describeNode(typeEntry.node)}`,
+          {
+            block: name,
+            expected: "the name of a block type",
+          },
+        );
       } else {
         type = t;
         def = catalog.get(t);
         if (!def) {
           const suggestion = closest(t, typeNames);
-          c.error("unknown-type", c.pos(typeEntry.node as YamlNode), `block '${name}': unknown block type '${t}'`, {
-            block: name,
-            ...(suggestion !== undefined ? { suggestion } : { expected: "a type listed in docs/blocks.md" }),
-          });
+          c.error(
+            "unknown-type",
+            c.pos(typeEntry.node as YamlNode),
+            `block '${name}': unknown block type '${t}'`,
+            {
+              block: name,
+              ...(suggestion !== undefined
+                ? { suggestion }
+                : { expected: "a type listed in docs/blocks.md" }),
+            },
+          );
         }
       }
     }
@@ -392,10 +452,15 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
     if (rateEntry) {
       const v = isScalar(rateEntry.node) ? rateEntry.node.value : undefined;
       if (typeof v !== "number" || !Number.isFinite(v) || v <= 0) {
-        c.error("bad-rate", c.pos(rateEntry.node as YamlNode), `block '${name}': DesiredRate has ${describeNode(rateEntry.node)}`, {
-          block: name,
-          expected: "a positive number of Hz",
-        });
+        c.error(
+          "bad-rate",
+          c.pos(rateEntry.node as YamlNode),
+          `block '${name}': DesiredRate has ${describeNode(rateEntry.node)}`,
+          {
+            block: name,
+            expected: "a positive number of Hz",
+          },
+        );
       } else {
         desiredRate = v;
       }
@@ -410,17 +475,26 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
     const inputs: InputRef[] = [];
     const inputsEntry = get("Inputs");
     const inputsPos = inputsEntry ? c.pos(inputsEntry.node as YamlNode) : at;
-    if (inputsEntry && inputsEntry.node !== null && !(isScalar(inputsEntry.node) && inputsEntry.node.value === null)) {
+    if (
+      inputsEntry &&
+      inputsEntry.node !== null &&
+      !(isScalar(inputsEntry.node) && inputsEntry.node.value === null)
+    ) {
       const items: unknown[] = isSeq(inputsEntry.node)
         ? inputsEntry.node.items
         : isScalar(inputsEntry.node)
           ? [inputsEntry.node]
           : [];
       if (!isSeq(inputsEntry.node) && !isScalar(inputsEntry.node)) {
-        c.error("bad-inputs", inputsPos, `block '${name}': Inputs is ${describeNode(inputsEntry.node)}`, {
-          block: name,
-          expected: "a list of block names, e.g. `Inputs: [Timer]`",
-        });
+        c.error(
+          "bad-inputs",
+          inputsPos,
+          `block '${name}': Inputs is ${describeNode(inputsEntry.node)}`,
+          {
+            block: name,
+            expected: "a list of block names, e.g. `Inputs: [Timer]`",
+          },
+        );
       }
       for (const item of items) {
         const s = scalarString(item);
@@ -449,12 +523,20 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
     let path: string | undefined;
     const pathEntry = get("Path");
     if (pathEntry) {
-      const s = isScalar(pathEntry.node) && typeof pathEntry.node.value === "string" ? pathEntry.node.value : undefined;
+      const s =
+        isScalar(pathEntry.node) && typeof pathEntry.node.value === "string"
+          ? pathEntry.node.value
+          : undefined;
       if (s === undefined || s.trim() === "") {
-        c.error("bad-path", c.pos(pathEntry.node as YamlNode), `block '${name}': Path is ${describeNode(pathEntry.node)}`, {
-          block: name,
-          expected: "a folder (the log is <Path>/<block>.txt) or a file name",
-        });
+        c.error(
+          "bad-path",
+          c.pos(pathEntry.node as YamlNode),
+          `block '${name}': Path is ${describeNode(pathEntry.node)}`,
+          {
+            block: name,
+            expected: "a folder (the log is <Path>/<block>.txt) or a file name",
+          },
+        );
       } else {
         path = s;
       }
@@ -466,10 +548,15 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
     if (workerEntry) {
       const s = scalarString(workerEntry.node);
       if (s === undefined || !WORKER_RE.test(s)) {
-        c.error("bad-worker", c.pos(workerEntry.node as YamlNode), `block '${name}': Worker is ${describeNode(workerEntry.node)}`, {
-          block: name,
-          expected: "a worker name (a plain word); blocks with the same name share a thread",
-        });
+        c.error(
+          "bad-worker",
+          c.pos(workerEntry.node as YamlNode),
+          `block '${name}': Worker is ${describeNode(workerEntry.node)}`,
+          {
+            block: name,
+            expected: "a worker name (a plain word); blocks with the same name share a thread",
+          },
+        );
       } else {
         worker = s;
       }
@@ -481,10 +568,15 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
     if (queueEntry) {
       const qn = queueEntry.node;
       if (!isMap(qn)) {
-        c.error("bad-queue", c.pos(qn as YamlNode), `block '${name}': Queue is ${describeNode(qn)}`, {
-          block: name,
-          expected: "`{ Policy: drop-oldest | drop-newest | latest, Capacity: <events> }`",
-        });
+        c.error(
+          "bad-queue",
+          c.pos(qn as YamlNode),
+          `block '${name}': Queue is ${describeNode(qn)}`,
+          {
+            block: name,
+            expected: "`{ Policy: drop-oldest | drop-newest | latest, Capacity: <events> }`",
+          },
+        );
       } else {
         for (const it of qn.items) {
           const k = scalarString(it.key) ?? "";
@@ -503,20 +595,31 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
             }
           } else if (k === "Capacity") {
             const v = isScalar(it.value) ? it.value.value : undefined;
-            if (typeof v === "number" && Number.isInteger(v) && v >= 1 && v <= 1 << 24) queue.capacity = v;
+            if (typeof v === "number" && Number.isInteger(v) && v >= 1 && v <= 1 << 24)
+              queue.capacity = v;
             else
-              c.error("bad-queue", vpos, `block '${name}': Queue.Capacity has ${describeNode(it.value)}`, {
-                block: name,
-                param: "Queue.Capacity",
-                expected: "a whole number of events between 1 and 16777216",
-              });
+              c.error(
+                "bad-queue",
+                vpos,
+                `block '${name}': Queue.Capacity has ${describeNode(it.value)}`,
+                {
+                  block: name,
+                  param: "Queue.Capacity",
+                  expected: "a whole number of events between 1 and 16777216",
+                },
+              );
           } else {
             const suggestion = closest(k, ["Policy", "Capacity"]);
-            c.error("bad-queue", c.pos(it.key as YamlNode), `block '${name}': unknown Queue key '${k}'`, {
-              block: name,
-              expected: "Policy or Capacity",
-              ...(suggestion !== undefined ? { suggestion } : {}),
-            });
+            c.error(
+              "bad-queue",
+              c.pos(it.key as YamlNode),
+              `block '${name}': unknown Queue key '${k}'`,
+              {
+                block: name,
+                expected: "Policy or Capacity",
+                ...(suggestion !== undefined ? { suggestion } : {}),
+              },
+            );
           }
         }
       }
@@ -529,13 +632,23 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
       const ln = layoutEntry.node;
       const xs = isMap(ln) ? ln.get("X") : undefined;
       const ys = isMap(ln) ? ln.get("Y") : undefined;
-      if (typeof xs === "number" && typeof ys === "number" && Number.isFinite(xs) && Number.isFinite(ys)) {
+      if (
+        typeof xs === "number" &&
+        typeof ys === "number" &&
+        Number.isFinite(xs) &&
+        Number.isFinite(ys)
+      ) {
         layout = { x: xs, y: ys };
       } else {
-        c.error("bad-layout", c.pos(ln as YamlNode), `block '${name}': Layout is ${describeNode(ln)}`, {
-          block: name,
-          expected: "`{ X: <number>, Y: <number> }`",
-        });
+        c.error(
+          "bad-layout",
+          c.pos(ln as YamlNode),
+          `block '${name}': Layout is ${describeNode(ln)}`,
+          {
+            block: name,
+            expected: "`{ X: <number>, Y: <number> }`",
+          },
+        );
       }
     }
 
@@ -550,16 +663,25 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
       const knownKeys = objectKeys(def.params);
       let raw: unknown = {};
       let rawOk = true;
-      if (paramsNode === undefined || paramsNode === null || (isScalar(paramsNode) && paramsNode.value === null)) {
+      if (
+        paramsNode === undefined ||
+        paramsNode === null ||
+        (isScalar(paramsNode) && paramsNode.value === null)
+      ) {
         raw = {};
       } else if (isSeq(paramsNode)) {
         const args = legacyArgs(paramsNode);
         if (!def.legacyParams) {
           rawOk = false;
-          c.error("legacy-unsupported", paramsPos, `block '${name}' (${type}): Params is a positional list, but ${type} has no positional form`, {
-            block: name,
-            expected: `named params: a mapping with ${knownKeys && knownKeys.length ? knownKeys.join(", ") : "no keys"}`,
-          });
+          c.error(
+            "legacy-unsupported",
+            paramsPos,
+            `block '${name}' (${type}): Params is a positional list, but ${type} has no positional form`,
+            {
+              block: name,
+              expected: `named params: a mapping with ${knownKeys && knownKeys.length ? knownKeys.join(", ") : "no keys"}`,
+            },
+          );
         } else if (args.length === 0 || (args.length === 1 && args[0] === "")) {
           raw = def.legacyParams([]);
           legacy = true;
@@ -569,11 +691,16 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
             legacy = true;
           } catch (e) {
             rawOk = false;
-            c.error("legacy-params", paramsPos, `block '${name}' (${type}): cannot convert positional Params [${args.join(", ")}]: ${errorMessage(e)}`, {
-              block: name,
-              ...(e instanceof LegacyParamsError && e.param ? { param: e.param } : {}),
-              ...(def.legacyForm ? { expected: def.legacyForm } : {}),
-            });
+            c.error(
+              "legacy-params",
+              paramsPos,
+              `block '${name}' (${type}): cannot convert positional Params [${args.join(", ")}]: ${errorMessage(e)}`,
+              {
+                block: name,
+                ...(e instanceof LegacyParamsError && e.param ? { param: e.param } : {}),
+                ...(def.legacyForm ? { expected: def.legacyForm } : {}),
+              },
+            );
           }
         }
       } else if (isMap(paramsNode)) {
@@ -581,28 +708,46 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
           raw = paramsNode.toJS(doc);
         } catch (e) {
           rawOk = false;
-          c.error("bad-params", paramsPos, `block '${name}': cannot read Params: ${errorMessage(e)}`, { block: name });
+          c.error(
+            "bad-params",
+            paramsPos,
+            `block '${name}': cannot read Params: ${errorMessage(e)}`,
+            { block: name },
+          );
         }
       } else {
         rawOk = false;
-        c.error("bad-params", paramsPos, `block '${name}' (${type}): Params is ${describeNode(paramsNode)}`, {
-          block: name,
-          expected: `a mapping${knownKeys && knownKeys.length ? ` with ${knownKeys.join(", ")}` : ""}${def.legacyParams ? ", or MOSAIC's positional list" : ""}`,
-        });
+        c.error(
+          "bad-params",
+          paramsPos,
+          `block '${name}' (${type}): Params is ${describeNode(paramsNode)}`,
+          {
+            block: name,
+            expected: `a mapping${knownKeys && knownKeys.length ? ` with ${knownKeys.join(", ")}` : ""}${def.legacyParams ? ", or MOSAIC's positional list" : ""}`,
+          },
+        );
       }
       if (rawOk) {
         const r = def.params.safeParse(raw, { reportInput: true });
         if (r.success) {
           params = r.data;
           if (legacy) {
-            c.add("warning", "legacy-converted", paramsPos, `block '${name}' (${type}): converted MOSAIC positional Params to ${JSON.stringify(raw)}`, {
-              block: name,
-            });
+            c.add(
+              "warning",
+              "legacy-converted",
+              paramsPos,
+              `block '${name}' (${type}): converted MOSAIC positional Params to ${JSON.stringify(raw)}`,
+              {
+                block: name,
+              },
+            );
           }
           try {
             outputs = outputNames(def, params);
           } catch (e) {
-            c.error("bad-params", paramsPos, `block '${name}' (${type}): ${errorMessage(e)}`, { block: name });
+            c.error("bad-params", paramsPos, `block '${name}' (${type}): ${errorMessage(e)}`, {
+              block: name,
+            });
           }
         } else {
           for (const issue of r.error.issues) {
@@ -621,12 +766,17 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
             const message = unknownKeyMsg
               ? `block '${name}' (${type}): ${ex.message}`
               : `block '${name}' (${type}): ${subject} ${ex.message}`;
-            c.error("bad-param", kpos, message + (legacy ? " (after converting the positional Params)" : ""), {
-              block: name,
-              ...(p !== "" ? { param: p } : {}),
-              ...(ex.expected !== undefined ? { expected: ex.expected } : {}),
-              ...(ex.suggestion !== undefined ? { suggestion: ex.suggestion } : {}),
-            });
+            c.error(
+              "bad-param",
+              kpos,
+              message + (legacy ? " (after converting the positional Params)" : ""),
+              {
+                block: name,
+                ...(p !== "" ? { param: p } : {}),
+                ...(ex.expected !== undefined ? { expected: ex.expected } : {}),
+                ...(ex.suggestion !== undefined ? { suggestion: ex.suggestion } : {}),
+              },
+            );
           }
         }
       }
@@ -656,40 +806,63 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
   }
 
   // Wiring: every input names an existing block (and port); arity matches the block type.
-  const allNames = [...(root as YAMLMap).items].map((p) => scalarString(p.key)).filter((s): s is string => !!s);
+  const allNames = [...(root as YAMLMap).items]
+    .map((p) => scalarString(p.key))
+    .filter((s): s is string => !!s);
   for (const b of blocks) {
     for (const inp of b.inputs) {
       const src = byName.get(inp.block);
       if (!src) {
         if (allNames.includes(inp.block)) continue; // that block has its own error already
         const suggestion = closest(inp.block, allNames);
-        c.error("missing-input", inp.pos, `block '${b.name}': input '${inp.block}' is not a block in this pipeline`, {
-          block: b.name,
-          ...(suggestion !== undefined ? { suggestion } : { expected: `one of ${allNames.join(", ")}` }),
-        });
+        c.error(
+          "missing-input",
+          inp.pos,
+          `block '${b.name}': input '${inp.block}' is not a block in this pipeline`,
+          {
+            block: b.name,
+            ...(suggestion !== undefined
+              ? { suggestion }
+              : { expected: `one of ${allNames.join(", ")}` }),
+          },
+        );
         continue;
       }
       if (inp.port === "") {
         inp.port = src.outputs[0] ?? "out";
       } else if (!src.outputs.includes(inp.port)) {
         const suggestion = closest(inp.port, src.outputs);
-        c.error("missing-port", inp.pos, `block '${b.name}': '${inp.block}' has no output '${inp.port}'`, {
-          block: b.name,
-          expected: `one of ${src.outputs.map((o) => `${inp.block}.${o}`).join(", ")}`,
-          ...(suggestion !== undefined ? { suggestion: `${inp.block}.${suggestion}` } : {}),
-        });
+        c.error(
+          "missing-port",
+          inp.pos,
+          `block '${b.name}': '${inp.block}' has no output '${inp.port}'`,
+          {
+            block: b.name,
+            expected: `one of ${src.outputs.map((o) => `${inp.block}.${o}`).join(", ")}`,
+            ...(suggestion !== undefined ? { suggestion: `${inp.block}.${suggestion}` } : {}),
+          },
+        );
       }
     }
     const n = b.inputs.length;
     const { min, max } = b.def.inputs;
     if (n < min || n > max) {
       const want =
-        min === max ? `exactly ${min}` : max === Infinity ? `at least ${min}` : `between ${min} and ${max}`;
+        min === max
+          ? `exactly ${min}`
+          : max === Infinity
+            ? `at least ${min}`
+            : `between ${min} and ${max}`;
       const labels = b.def.inputs.labels ? ` (${b.def.inputs.labels.join(", ")})` : "";
-      c.error("input-count", b.inputsPos, `block '${b.name}' (${b.type}) has ${n} input${n === 1 ? "" : "s"}`, {
-        block: b.name,
-        expected: `${want} input${max === 1 ? "" : "s"}${labels}`,
-      });
+      c.error(
+        "input-count",
+        b.inputsPos,
+        `block '${b.name}' (${b.type}) has ${n} input${n === 1 ? "" : "s"}`,
+        {
+          block: b.name,
+          expected: `${want} input${max === 1 ? "" : "s"}${labels}`,
+        },
+      );
     }
   }
 

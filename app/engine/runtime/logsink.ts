@@ -21,14 +21,24 @@ export interface LogSink {
 }
 
 /** Formats one event as a log line (without the newline). */
-export function formatLogLine(t: number, v: ArrayLike<number>, offset: number, count: number): string {
+export function formatLogLine(
+  t: number,
+  v: ArrayLike<number>,
+  offset: number,
+  count: number,
+): string {
   let s = t.toFixed(6);
   for (let k = 0; k < count; k++) s += "," + String(v[offset + k]);
   return s;
 }
 
 /** Resolves the log file name for a block's Path (relative to whatever base the sink uses). */
-export function logFileName(path: string, block: string, port: string, isDefaultPort: boolean): string {
+export function logFileName(
+  path: string,
+  block: string,
+  port: string,
+  isDefaultPort: boolean,
+): string {
   const file = isDefaultPort ? `${block}.txt` : `${block}.${port}.txt`;
   const trimmed = path.replace(/[\\/]+$/, "");
   const endsWithSep = /[\\/]$/.test(path);
@@ -48,7 +58,8 @@ export class MemoryLogSink implements LogSink {
     this.files.set(name, lines);
     return {
       write(f: Frame) {
-        for (let i = 0; i < f.n; i++) lines.push(formatLogLine(f.t[i]!, f.v, i * f.stride, f.stride));
+        for (let i = 0; i < f.n; i++)
+          lines.push(formatLogLine(f.t[i]!, f.v, i * f.stride, f.stride));
       },
       close() {},
     };

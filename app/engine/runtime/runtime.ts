@@ -53,7 +53,14 @@ export interface BlockTelemetry {
   lastError: string;
   finished: boolean;
   /** Timers only. */
-  timer?: { fired: number; missed: number; latenessP50Us: number; latenessP99Us: number; latenessMaxUs: number; running: boolean };
+  timer?: {
+    fired: number;
+    missed: number;
+    latenessP50Us: number;
+    latenessP99Us: number;
+    latenessMaxUs: number;
+    running: boolean;
+  };
   /** ΔT between consecutive outputs (emission clock), since start or the last `resetTiming`. */
   timing: { n: number; meanDt: number; stdDt: number; computeTotalMs: number; calls: number };
 }
@@ -332,7 +339,8 @@ export class Runtime {
         ...(param !== undefined ? { param } : {}),
       });
     };
-    const isLocal = (b: BlockSpec): boolean => opts.ignorePlacement === true || b.worker === rt.worker;
+    const isLocal = (b: BlockSpec): boolean =>
+      opts.ignorePlacement === true || b.worker === rt.worker;
     const ghosts = new Map<string, Ghost>();
     if (opts.plan) {
       for (const p of opts.plan.blocks) {
@@ -380,7 +388,8 @@ export class Runtime {
         node.instance = await b.def.create(ctx, b.params);
       } catch (e) {
         const param = e instanceof BlockConfigError ? e.param : undefined;
-        const pos = param !== undefined ? (b.paramPos[param.split(/[.[]/)[0]!] ?? b.paramsPos) : b.pos;
+        const pos =
+          param !== undefined ? (b.paramPos[param.split(/[.[]/)[0]!] ?? b.paramsPos) : b.pos;
         diag(b, pos, errorMessage(e), param);
         continue;
       }
@@ -416,6 +425,19 @@ export class Runtime {
       }),
     };
     for (const n of planning) rt.safeDispose(n);
+    if (!opts.plan) {
+      // Blocks placed on other workers are known from here on through the plan, like elsewhere.
+      for (const p of plan.blocks) {
+        if (rt.byName.has(p.name)) continue;
+        ghosts.set(p.name, {
+          name: p.name,
+          worker: p.worker,
+          desiredRate: p.desiredRate,
+          isTimer: p.isTimer,
+          outputs: new Map(p.outputs.map((o) => [o.name, o.shape])),
+        });
+      }
+    }
 
     // Edges (in file order of consumers, so delivery order is stable).
     for (const b of opts.spec.blocks) {
@@ -492,7 +514,12 @@ export class Runtime {
         if (node.ports.some((p) => p.name === name)) {
           throw new Error(`output '${name}' declared twice`);
         }
-        if (!(shape.rows >= 1 && shape.cols >= 0 && Number.isInteger(shape.rows) && Number.isInteger(shape.cols))) {
+        if (!(
+          shape.rows >= 1 &&
+          shape.cols >= 0 &&
+          Number.isInteger(shape.rows) &&
+          Number.isInteger(shape.cols)
+        )) {
           throw new Error(`invalid output shape ${formatShape(shape)}`);
         }
         const p = new OutPort(node, name, shape);
@@ -568,7 +595,8 @@ export class Runtime {
       return;
     }
     const now = this.clock.now();
-    port.node.status.record(f, now);
+    // Status follows the default (first) output; other ports emit in step with it.
+    if (port === port.node.ports[0]) port.node.status.record(f, now);
     if (port.log) port.log.write(f);
     const taps = port.taps;
     for (let i = 0; i < taps.length; i++) taps[i]!(f);
@@ -646,7 +674,10 @@ export class Runtime {
     } catch (err) {
       this.fail(node, err);
     }
-    node.status.compute(performance.now() - t0, this.clock.now());
+    const now = this.clock.now();
+    node.status.compute(performance.now() - t0, now);
+    // A block without outputs (a sink, a device output) is timed by what it consumes.
+    if (node.ports.length === 0) node.status.record(f, now);
   }
 
   private fireEntry = (e: TimerEntry, t: number): void => {
@@ -797,12 +828,19 @@ export class Runtime {
     const edge =
       typeof input === "number"
         ? node.inEdges[input]
-        : node.inEdges.find((e) => node.spec.inputs[e.toIndex]!.source === input || node.spec.inputs[e.toIndex]!.block === input);
+        : node.inEdges.find(
+            (e) =>
+              node.spec.inputs[e.toIndex]!.source === input ||
+              node.spec.inputs[e.toIndex]!.block === input,
+          );
     if (!edge) {
       const names = node.spec.inputs.map((i) => i.source).join(", ");
-      throw new Error(`block '${block}' has no input '${String(input)}' (its inputs: ${names || "none"})`);
+      throw new Error(
+        `block '${block}' has no input '${String(input)}' (its inputs: ${names || "none"})`,
+      );
     }
-    if (edge.subscribed === subscribed) return `${block} ${subscribed ? "already subscribed to" : "was not subscribed to"} ${node.spec.inputs[edge.toIndex]!.source}`;
+    if (edge.subscribed === subscribed)
+      return `${block} ${subscribed ? "already subscribed to" : "was not subscribed to"} ${node.spec.inputs[edge.toIndex]!.source}`;
     edge.subscribed = subscribed;
     if (!subscribed) this.cancelPending(edge, edge.queue.length);
     return `${block} ${subscribed ? "subscribed to" : "unsubscribed from"} ${node.spec.inputs[edge.toIndex]!.source}`;
@@ -824,8 +862,15 @@ export class Runtime {
     }
     const a = node.instance.actions?.[action];
     if (!a) {
-      const names = ["subscribe", "unsubscribe", "reset", ...Object.keys(node.instance.actions ?? {})];
-      throw new Error(`block '${block}' has no action '${action}' (its actions: ${names.join(", ")})`);
+      const names = [
+        "subscribe",
+        "unsubscribe",
+        "reset",
+        ...Object.keys(node.instance.actions ?? {}),
+      ];
+      throw new Error(
+        `block '${block}' has no action '${action}' (its actions: ${names.join(", ")})`,
+      );
     }
     const r = a.run(arg);
     this.onWake?.();

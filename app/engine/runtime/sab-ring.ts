@@ -44,7 +44,11 @@ export class SabRing {
   }
 
   get init(): SabRingInit {
-    return { sab: this.ctrl.buffer as SharedArrayBuffer, capacity: this.capacity, stride: this.stride };
+    return {
+      sab: this.ctrl.buffer as SharedArrayBuffer,
+      capacity: this.capacity,
+      stride: this.stride,
+    };
   }
 
   available(): number {
@@ -91,7 +95,7 @@ export class SabRing {
       }
       const k = Math.min(free, n - done);
       for (let i = 0; i < k; i++) {
-        const base = ((w + i) >>> 0) % cap * slot;
+        const base = (((w + i) >>> 0) % cap) * slot;
         const e = done + i;
         data[base] = f.t[e]!;
         const src = e * s;
@@ -118,7 +122,7 @@ export class SabRing {
     const cap = this.capacity;
     const data = this.data;
     for (let i = 0; i < n; i++) {
-      const base = ((r + i) >>> 0) % cap * slot;
+      const base = (((r + i) >>> 0) % cap) * slot;
       into.t[i] = data[base]!;
       const dst = i * s;
       for (let j = 0; j < s; j++) into.v[dst + j] = data[base + 1 + j]!;

@@ -138,13 +138,14 @@ export class Scheduler {
         if (this.virtual) {
           due.k++;
         } else {
-          due.lateness?.add((now - deadline) * 1e6);
-          // Skip, and count, the ticks whose deadline has already passed by a whole period.
+          // Skip, and count, the older ticks whose deadlines have all passed: fire once, for the
+          // most recent deadline, and measure lateness against that one.
           const behind = Math.floor((now - deadline) / due.period);
           if (behind > 0) {
             due.missed += behind;
             due.k += behind;
           }
+          due.lateness?.add((now - (due.base + due.k * due.period)) * 1e6);
           due.k++;
         }
         due.next = due.base + due.k * due.period;

@@ -118,7 +118,12 @@ export class StatusTracker {
     const d = this.desiredRate;
     const idleAfter = d > 0 ? IDLE_PERIODS / d : APERIODIC_IDLE_S;
     if (this.events === 0 || now - this.lastWall > idleAfter) {
-      return { status: "idle", rate: this.events === 0 ? 0 : rate, lagging: false, stumbling: false };
+      return {
+        status: "idle",
+        rate: this.events === 0 ? 0 : rate,
+        lagging: false,
+        stumbling: false,
+      };
     }
     const lagging = d > 0 && rate === rate && rate < LAG_FRACTION * d;
     const n = this.inWindow;

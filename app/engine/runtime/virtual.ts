@@ -11,7 +11,12 @@ export type VirtualStop = "until" | "finished" | "yield";
  * Runs `rt` on `clock` until virtual time `until` (inclusive), until every finite source has
  * finished, or until `wallBudgetMs` of real time has passed (then returns "yield": call again).
  */
-export function runVirtual(rt: Runtime, clock: VirtualClock, until: number, wallBudgetMs = Infinity): VirtualStop {
+export function runVirtual(
+  rt: Runtime,
+  clock: VirtualClock,
+  until: number,
+  wallBudgetMs = Infinity,
+): VirtualStop {
   const wallStart = performance.now();
   let i = 0;
   for (;;) {

@@ -1,0 +1,340 @@
+import { describe, expect, test } from "vitest";
+import { z } from "zod";
+import { defineBlock } from "../block";
+import { createCatalog } from "../catalog";
+import { Frame, vectorShape } from "../frame";
+import { TEST_BLOCKS } from "../test-blocks";
+import { runVirtualPipeline } from "../testing";
+import { Scheduler } from "./scheduler";
+import { StatusTracker } from "./status";
+
+/** Emits `Count` one-event frames per input event (a bursty producer). */
+const Burst = defineBlock({
+  type: "Burst",
+  category: "Testing",
+  summary: "burst",
+  help: "burst",
+  params: z.strictObject({ Count: z.number().int().default(3).describe("frames per input") }),
+  inputs: { min: 1, max: 1 },
+  create(ctx, p) {
+    const out = ctx.output(vectorShape(1));
+    let k = 0;
+    return {
+      process(f) {
+        for (let i = 0; i < f.n; i++) {
+          for (let j = 0; j < p.Count; j++) {
+            const o = out.frame(1);
+            o.t[0] = f.t[i]!;
+            o.v[0] = ++k;
+            out.emit(o);
+          }
+        }
+      },
+    };
+  },
+});
+
+/** Throws on every odd event. */
+const Flaky = defineBlock({
+  type: "Flaky",
+  category: "Testing",
+  summary: "flaky",
+  help: "flaky",
+  params: z.strictObject({}),
+  inputs: { min: 1, max: 1 },
+  create(ctx) {
+    const out = ctx.output(vectorShape(1));
+    let k = 0;
+    return {
+      process(f) {
+        if (k++ % 2 === 1) throw new Error("odd event");
+        const o = out.frame(f.n);
+        o.copyEvents(f, 0, f.n, 0);
+        out.emit(o);
+      },
+    };
+  },
+});
+
+/** y[n] = x[n] + 0.5 * (its own previous output, fed back through the graph). */
+const Mix = defineBlock({
+  type: "Mix",
+  category: "Testing",
+  summary: "feedback mixer",
+  help: "feedback mixer",
+  params: z.strictObject({}),
+  inputs: { min: 2, max: 2 },
+  create(ctx) {
+    const out = ctx.output(vectorShape(1));
+    let fb = 0;
+    return {
+      process(f, port) {
+        if (port === 1) {
+          fb = f.v[(f.n - 1) * f.stride]!;
+          return;
+        }
+        const o = out.frame(f.n);
+        for (let i = 0; i < f.n; i++) {
+          o.t[i] = f.t[i]!;
+          o.v[i] = f.v[i * f.stride]! + 0.5 * fb;
+        }
+        out.emit(o);
+      },
+    };
+  },
+});
+
+const catalog = createCatalog([...TEST_BLOCKS, Burst, Flaky, Mix]);
+
+describe("delivery", () => {
+  test("breadth-first, deterministic, ports and fan-out", async () => {
+    const run = await runVirtualPipeline(
+      `
+T: { Type: Tick, DesiredRate: 10 }
+C: { Type: Counter, Inputs: [T], Params: { Channels: 4 } }
+H: { Type: Halves, Inputs: [C] }
+A: { Type: Gain, Inputs: [H.a], Params: { Gain: 10 } }
+B: { Type: Gain, Inputs: [H.b], Params: { Gain: -1 } }
+`,
+      { catalog, duration: 0.25 },
+    );
+    expect(run.outputs.get("C")!.v).toEqual([
+      [1, 1, 1, 1],
+      [2, 2, 2, 2],
+      [3, 3, 3, 3],
+    ]);
+    expect(run.outputs.get("A")!.v).toEqual([
+      [10, 10],
+      [20, 20],
+      [30, 30],
+    ]);
+    expect(run.outputs.get("B")!.v).toEqual([
+      [-1, -1],
+      [-2, -2],
+      [-3, -3],
+    ]);
+    expect(run.outputs.get("A")!.t).toEqual([0, 0.1, 0.2]);
+  });
+
+  test("feedback cycles run without re-entrance", async () => {
+    const run = await runVirtualPipeline(
+      `
+T: { Type: Tick, DesiredRate: 1 }
+C: { Type: Counter, Inputs: [T] }
+M: { Type: Mix, Inputs: [C, G] }
+G: { Type: Gain, Inputs: [M], Params: { Gain: 1 } }
+`,
+      { catalog, duration: 3 },
+    );
+    // M sees its own previous output (through G) before the next counter value.
+    expect(run.outputs.get("M")!.v.map((r) => r[0])).toEqual([1, 2.5, 4.25, 6.125]);
+  });
+
+  test("drop-oldest keeps the newest events within capacity and counts drops", async () => {
+    const run = await runVirtualPipeline(
+      `
+T: { Type: Tick, DesiredRate: 1 }
+B: { Type: Burst, Inputs: [T], Params: { Count: 5 } }
+G: { Type: Gain, Inputs: [B], Params: { Gain: 1 }, Queue: { Capacity: 2 } }
+`,
+      { catalog, duration: 0 },
+    );
+    expect(run.outputs.get("G")!.v.map((r) => r[0])).toEqual([4, 5]);
+    const edge = run.telemetry.edges.find((e) => e.to === "G")!;
+    expect(edge).toMatchObject({ dropped: 3, delivered: 2 });
+    expect(run.telemetry.blocks.find((b) => b.name === "G")!.dropsIn).toBe(3);
+  });
+
+  test("drop-newest keeps the oldest", async () => {
+    const run = await runVirtualPipeline(
+      `
+T: { Type: Tick, DesiredRate: 1 }
+B: { Type: Burst, Inputs: [T], Params: { Count: 5 } }
+G: { Type: Gain, Inputs: [B], Params: { Gain: 1 }, Queue: { Policy: drop-newest, Capacity: 2 } }
+`,
+      { catalog, duration: 0 },
+    );
+    expect(run.outputs.get("G")!.v.map((r) => r[0])).toEqual([1, 2]);
+  });
+
+  test("latest delivers only the newest event", async () => {
+    const run = await runVirtualPipeline(
+      `
+T: { Type: Tick, DesiredRate: 1 }
+B: { Type: Burst, Inputs: [T], Params: { Count: 4 } }
+G: { Type: Gain, Inputs: [B], Params: { Gain: 1 }, Queue: { Policy: latest } }
+`,
+      { catalog, duration: 1 },
+    );
+    expect(run.outputs.get("G")!.v.map((r) => r[0])).toEqual([4, 8]);
+    expect(run.telemetry.edges.find((e) => e.to === "G")!.dropped).toBe(6);
+  });
+
+  test("-Name inputs are declared but not subscribed until subscribed at run time", async () => {
+    const run = await runVirtualPipeline(
+      `
+T: { Type: Tick, DesiredRate: 1 }
+C: { Type: Counter, Inputs: [T] }
+G: { Type: Gain, Inputs: [-C], Params: { Gain: 1 } }
+`,
+      {
+        catalog,
+        duration: 0,
+      },
+    );
+    expect(run.outputs.get("G")!.v).toEqual([]);
+    const run2 = await runVirtualPipeline(
+      `
+T: { Type: Tick, DesiredRate: 1 }
+C: { Type: Counter, Inputs: [T] }
+G: { Type: Gain, Inputs: [-C], Params: { Gain: 1 } }
+`,
+      { catalog, duration: 2, beforeRun: (rt) => rt.invoke("G", "subscribe", "C") },
+    );
+    expect(run2.outputs.get("G")!.v.map((r) => r[0])).toEqual([1, 2, 3]);
+    expect(run2.telemetry.edges.find((e) => e.to === "G")!.subscribed).toBe(true);
+  });
+
+  test("a failing block reports its error and the rest keeps running", async () => {
+    const run = await runVirtualPipeline(
+      `
+T: { Type: Tick, DesiredRate: 1 }
+C: { Type: Counter, Inputs: [T] }
+F: { Type: Flaky, Inputs: [C] }
+G: { Type: Gain, Inputs: [C], Params: { Gain: 2 } }
+`,
+      { catalog, duration: 3 },
+    );
+    expect(run.outputs.get("G")!.v.map((r) => r[0])).toEqual([2, 4, 6, 8]);
+    expect(run.outputs.get("F")!.v.map((r) => r[0])).toEqual([1, 3]);
+    const f = run.telemetry.blocks.find((b) => b.name === "F")!;
+    expect(f.errors).toBe(2);
+    expect(f.lastError).toBe("odd event");
+    expect(run.telemetry.events[0]).toMatchObject({
+      level: "error",
+      block: "F",
+      message: "odd event",
+    });
+  });
+
+  test("live params are validated before they reach the block", async () => {
+    const run = await runVirtualPipeline(
+      `
+T: { Type: Tick, DesiredRate: 1 }
+C: { Type: Counter, Inputs: [T] }
+`,
+      {
+        catalog,
+        duration: 1,
+        beforeRun: (rt) => {
+          expect(() => rt.setParam("C", "Scale", "big")).toThrow(/invalid value for 'Scale'/);
+          expect(() => rt.setParam("C", "Channels", 3)).toThrow(
+            /cannot be changed while running \(live params: Scale\)/,
+          );
+          expect(() => rt.invoke("C", "explode")).toThrow(
+            /no action 'explode'.*subscribe, unsubscribe, reset/,
+          );
+          rt.setParam("C", "Scale", 10);
+        },
+      },
+    );
+    expect(run.outputs.get("C")!.v).toEqual([[10], [20]]);
+  });
+
+  test("Path logs: timestamp with microseconds, values in shortest round-trip form", async () => {
+    const run = await runVirtualPipeline(
+      `
+T: { Type: Tick, DesiredRate: 3 }
+C: { Type: Counter, Inputs: [T], Params: { Channels: 2, Scale: 0.1 }, Path: out/ }
+`,
+      { catalog, duration: 1, start: 1700000000 },
+    );
+    expect(run.logs.text("out/C.txt")).toBe(
+      "1700000000.000000,0.1,0.1\n1700000000.333333,0.2,0.2\n1700000000.666667,0.30000000000000004,0.30000000000000004\n1700000001.000000,0.4,0.4\n",
+    );
+  });
+});
+
+describe("scheduler", () => {
+  test("skips and counts missed ticks instead of bursting", () => {
+    const s = new Scheduler(false);
+    const fired: number[] = [];
+    const e = s.add("t", 0.01, (t) => fired.push(t));
+    s.start(e, 100);
+    s.fireDue(100, (x, t) => x.cb(t));
+    // The worker was blocked for 35 ms: one tick fires now, three are skipped.
+    s.fireDue(100.035, (x, t) => x.cb(t));
+    expect(fired).toEqual([100, 100.035]);
+    expect(e.missed).toBe(2);
+    expect(e.next).toBeCloseTo(100.04, 12);
+    expect(e.lateness!.count).toBe(2);
+    expect(e.lateness!.quantile(1)).toBe(5000);
+  });
+
+  test("deadlines are base + k/rate (no drift) and fire in deadline order", () => {
+    const s = new Scheduler(true);
+    const order: string[] = [];
+    const a = s.add("a", 0.1, () => order.push("a"));
+    const b = s.add("b", 0.25, () => order.push("b"));
+    s.start(a, 0);
+    s.start(b, 0);
+    let t = 0;
+    for (let i = 0; i < 12; i++) {
+      t = s.nextDeadline();
+      s.fireDue(t, (x, tt) => x.cb(tt));
+    }
+    // 0: a b, .1 a, .2 a, .25 b, .3 a, .4 a, .5 a b, .6 a, .7 a, .75 b, .8 a, .9 a
+    expect(order.join("")).toBe("abaabaaabaabaa");
+    expect(a.next).toBeCloseTo(0.1 * a.k, 15);
+  });
+});
+
+describe("status", () => {
+  const frameAt = (t: number) => Frame.from(vectorShape(1), [t], [[0]]);
+
+  test("rate over the last 100 outputs; on time; idle after 10 periods", () => {
+    const s = new StatusTracker(100);
+    for (let i = 0; i < 150; i++) s.record(frameAt(i / 100), i / 100);
+    const now = 1.49;
+    expect(s.rate()).toBeCloseTo(100, 9);
+    expect(s.evaluate(now)).toMatchObject({ status: "ontime", lagging: false, stumbling: false });
+    expect(s.evaluate(1.49 + 0.099).status).toBe("ontime");
+    expect(s.evaluate(1.49 + 0.101).status).toBe("idle");
+  });
+
+  test("lagging below 95 % of the desired rate", () => {
+    const s = new StatusTracker(100);
+    for (let i = 0; i < 100; i++) s.record(frameAt(i / 94), i / 94);
+    expect(s.evaluate(99 / 94).status).toBe("lagging");
+    const t = new StatusTracker(100);
+    for (let i = 0; i < 100; i++) t.record(frameAt(i / 96), i / 96);
+    expect(t.evaluate(99 / 96).status).toBe("ontime");
+  });
+
+  test("stumbling when one call took longer than a period, within the window; lagging wins", () => {
+    const s = new StatusTracker(100);
+    for (let i = 0; i < 100; i++) s.record(frameAt(i / 100), i / 100);
+    s.compute(10.5, 0.5);
+    expect(s.evaluate(0.99)).toMatchObject({ status: "stumbling", stumbling: true });
+    // 100 more outputs later the overrun has left the window.
+    for (let i = 100; i < 200; i++) s.record(frameAt(i / 100), i / 100);
+    expect(s.evaluate(1.99).status).toBe("ontime");
+    const l = new StatusTracker(100);
+    for (let i = 0; i < 100; i++) l.record(frameAt(i / 50), i / 50);
+    l.compute(20, 1);
+    expect(l.evaluate(99 / 50)).toMatchObject({
+      status: "lagging",
+      stumbling: true,
+      lagging: true,
+    });
+  });
+
+  test("idle before the first output; a pause does not read as lagging afterwards", () => {
+    const s = new StatusTracker(100);
+    expect(s.evaluate(0).status).toBe("idle");
+    for (let i = 0; i < 100; i++) s.record(frameAt(i / 100), i / 100);
+    for (let i = 0; i < 10; i++) s.record(frameAt(10 + i / 100), 10 + i / 100);
+    expect(s.evaluate(10.09)).toMatchObject({ status: "ontime" });
+    expect(s.rate()).toBeCloseTo(100, 6);
+  });
+});

@@ -1,0 +1,6 @@
+#!/usr/bin/env bash
+# Builds the WASM DSP core (skipped when up to date) and the Node bundles in dist/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/build-wasm.sh
+node scripts/build-ts.mjs

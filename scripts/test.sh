@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# The whole test suite: setup (idempotent), lint, format, types, Rust, fixtures, unit and
+# integration tests. This is what CI runs (.ci/run).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+step() { printf '\n\033[1m== %s\033[0m\n' "$*"; }
+
+step "setup and build"
+bash scripts/setup.sh
+
+step "lint (eslint, with the layering rule)"
+npx eslint --max-warnings 0 .
+
+step "format (prettier)"
+npx prettier --check . >/dev/null || { npx prettier --check . ; exit 1; }
+
+step "types (tsc, per runtime layer)"
+npx tsc -p tsconfig.pure.json
+npx tsc -p tsconfig.node.json
+
+step "rust (fmt, clippy, tests)"
+cargo fmt --manifest-path core-wasm/Cargo.toml --all -- --check
+cargo clippy --quiet --manifest-path core-wasm/Cargo.toml --workspace --all-targets -- -D warnings
+cargo test --quiet --manifest-path core-wasm/Cargo.toml --workspace
+
+step "reference fixtures are reproduced by their committed generators"
+bash scripts/check-fixtures.sh
+
+step "unit and integration tests (vitest)"
+npx vitest run
+
+printf '\n\033[1;32mall tests passed\033[0m\n'

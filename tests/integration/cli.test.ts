@@ -1,0 +1,109 @@
+import { readdirSync, readFileSync, writeFileSync } from "node:fs";
+import { join } from "node:path";
+import { beforeAll, describe, expect, test } from "vitest";
+import { jsonLines, requireBuild, ROOT, runCli, startCli, tempDir } from "./helpers";
+
+beforeAll(requireBuild);
+
+describe("mosaic validate", () => {
+  test("every pipeline in pipelines/ is valid", () => {
+    const files: string[] = [];
+    const walk = (d: string): void => {
+      for (const e of readdirSync(d, { withFileTypes: true })) {
+        if (e.isDirectory()) walk(join(d, e.name));
+        else if (e.name.endsWith(".yaml")) files.push(join(d, e.name));
+      }
+    };
+    walk(join(ROOT, "pipelines"));
+    expect(files.length).toBeGreaterThanOrEqual(3);
+    const r = runCli(["validate", ...files]);
+    expect(r.stderr.split("\n").filter((l) => l.includes(": error:"))).toEqual([]);
+    expect(r.code).toBe(0);
+  });
+
+  test("an invalid file exits 2 with file:line:col messages", () => {
+    const dir = tempDir();
+    const f = join(dir, "bad.yaml");
+    writeFileSync(
+      f,
+      "Timer: { Type: ScheduledTimer, DesiredRate: 200 }\nLowPass: { Type: Fliter, Inputs: [Timer] }\n",
+    );
+    const r = runCli(["validate", f]);
+    expect(r.code).toBe(2);
+    expect(r.stderr).toContain(
+      `${f}:2:17: error: block 'LowPass': unknown block type 'Fliter'; did you mean 'Filter'?`,
+    );
+  });
+
+  test("errors found when instantiating (a missing file) are positioned too", () => {
+    const dir = tempDir();
+    const f = join(dir, "nofile.yaml");
+    writeFileSync(
+      f,
+      "T: { Type: ScheduledTimer, DesiredRate: 100 }\nP:\n  Type: FilePlayer\n  Inputs: [T]\n  Params: { File: nope.csv }\n",
+    );
+    const r = runCli(["validate", f]);
+    expect(r.code).toBe(2);
+    expect(r.stderr).toMatch(/nofile\.yaml:5:\d+: error: block 'P' \(FilePlayer\): .*nope\.csv/);
+  });
+});
+
+describe("mosaic run", () => {
+  test("the demo runs with every block on time (5 s, real time)", () => {
+    const r = runCli(["run", "pipelines/demo.yaml", "--duration", "5", "--json"], {
+      timeoutMs: 30_000,
+    });
+    expect(r.code).toBe(0);
+    const lines = jsonLines(r.stdout);
+    const summary = lines.find((l) => l.type === "summary") as unknown as {
+      reason: string;
+      blocks: { name: string; status: string; rate: number; desiredRate: number }[];
+    };
+    expect(summary.reason).toBe("duration");
+    // Status at the last telemetry before stopping (the summary is taken after the stop).
+    const tel = lines.filter((l) => l.type === "telemetry").at(-1) as unknown as typeof summary;
+    const bad = tel.blocks
+      .filter((b) => b.status !== "ontime")
+      .map((b) => `${b.name}: ${b.status} ${b.rate}/${b.desiredRate}`);
+    expect(bad).toEqual([]);
+    expect(tel.blocks.length).toBe(9);
+  });
+
+  test("Ctrl-C stops cleanly and flushes the logs", async () => {
+    const dir = tempDir();
+    const f = join(dir, "log.yaml");
+    writeFileSync(
+      f,
+      "Timer: { Type: ScheduledTimer, DesiredRate: 500 }\nSine: { Type: SinGenerator, Inputs: [Timer], Params: { Components: 3 }, Path: rec/ }\n",
+    );
+    const child = startCli(["run", f, "--json"]);
+    let out = "";
+    child.stdout!.on("data", (d: Buffer) => (out += d.toString()));
+    await new Promise((r) => setTimeout(r, 2500));
+    child.kill("SIGINT");
+    const code = await new Promise<number | null>((r) => child.on("exit", r));
+    expect(code).toBe(0);
+    const summary = jsonLines(out).find((l) => l.type === "summary") as {
+      reason: string;
+      blocks: { name: string; events: number }[];
+    };
+    expect(summary.reason).toBe("interrupted");
+    const lines = readFileSync(join(dir, "rec", "Sine.txt"), "utf8").split("\n");
+    expect(lines.at(-1)).toBe("");
+    const events = summary.blocks.find((b) => b.name === "Sine")!.events;
+    expect(lines.length - 1).toBe(events);
+    expect(events).toBeGreaterThan(500);
+    for (const l of lines.slice(0, -1)) expect(l).toMatch(/^\d+\.\d{6}(,-?[\d.e+-]+){3}$/);
+  });
+
+  test("an invalid pipeline is not started and exits 2", () => {
+    const dir = tempDir();
+    const f = join(dir, "bad.yaml");
+    writeFileSync(f, "Timer: { Type: ScheduledTimer }\n");
+    const r = runCli(["run", f, "--duration", "1"]);
+    expect(r.code).toBe(2);
+    expect(r.stderr).toContain(
+      "bad.yaml:1:1: error: block 'Timer' (ScheduledTimer) needs a DesiredRate",
+    );
+  });
+});
