@@ -20,11 +20,15 @@ export const DecimatorTimer = defineBlock({
   create(ctx) {
     const input = ctx.inputs[0]!;
     if (!input.isTimer) {
-      throw new BlockConfigError(`its input '${input.source}' must be a timer (ScheduledTimer or DecimatorTimer)`);
+      throw new BlockConfigError(
+        `its input '${input.source}' must be a timer (ScheduledTimer or DecimatorTimer)`,
+      );
     }
     const desired = ctx.declaredRate ?? ctx.desiredRate;
     if (input.rate > 0 && desired > input.rate) {
-      throw new BlockConfigError(`DesiredRate ${desired} Hz is faster than its input timer's ${input.rate} Hz`);
+      throw new BlockConfigError(
+        `DesiredRate ${desired} Hz is faster than its input timer's ${input.rate} Hz`,
+      );
     }
     const factor = input.rate > 0 ? Math.max(1, Math.round(input.rate / desired)) : 1;
     const effective = input.rate > 0 ? input.rate / factor : desired;
@@ -34,7 +38,9 @@ export const DecimatorTimer = defineBlock({
       );
     }
     ctx.setDesiredRate(effective);
-    ctx.setText(`every ${factor}${factor === 1 ? "st" : factor === 2 ? "nd" : factor === 3 ? "rd" : "th"} tick`);
+    ctx.setText(
+      `every ${factor}${factor === 1 ? "st" : factor === 2 ? "nd" : factor === 3 ? "rd" : "th"} tick`,
+    );
     const out = ctx.output(EMPTY_SHAPE);
     let count = 0;
     return {

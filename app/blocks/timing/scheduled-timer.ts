@@ -28,7 +28,9 @@ export const ScheduledTimer = defineBlock({
       out.emit(f);
     });
     const describe = () => {
-      ctx.setText(timer.running ? (timer.missed > 0 ? `missed ${timer.missed} ticks` : "") : "stopped");
+      ctx.setText(
+        timer.running ? (timer.missed > 0 ? `missed ${timer.missed} ticks` : "") : "stopped",
+      );
     };
     return {
       start() {

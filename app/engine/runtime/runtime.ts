@@ -894,8 +894,9 @@ export class Runtime {
       const issue = r.error.issues[0]!;
       throw new Error(`invalid value for '${param}': ${issue.message}`);
     }
-    node.params = r.data;
+    // The block may still refuse the value (e.g. a width it cannot apply): keep the params in step.
     node.instance.setParam?.(param, (r.data as Record<string, unknown>)[param]);
+    node.params = r.data;
     return `${block}.${param} = ${JSON.stringify(value)}`;
   }
 
