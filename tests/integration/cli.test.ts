@@ -31,7 +31,7 @@ describe("mosaic validate", () => {
     const r = runCli(["validate", f]);
     expect(r.code).toBe(2);
     expect(r.stderr).toContain(
-      `${f}:2:17: error: block 'LowPass': unknown block type 'Fliter'; did you mean 'Filter'?`,
+      `${f}:2:18: error: block 'LowPass': unknown block type 'Fliter'; did you mean 'Filter'?`,
     );
   });
 

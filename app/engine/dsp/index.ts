@@ -1,0 +1,592 @@
+/**
+ * TypeScript face of the Rust DSP core (core-wasm/, built by `npm run build:wasm`).
+ *
+ * Runs anywhere the engine runs (Node worker_threads, browser Web Workers): no `node:` imports,
+ * no DOM, no console. Call `initDsp(bytes)` once per thread with the bytes of
+ * `core-wasm/pkg/mosaic_core_bg.wasm` (or a compiled `WebAssembly.Module`), then create kernels.
+ *
+ * Buffers are row-major interleaved: event `e`, channel `c` is at index `e * channels + c`.
+ * Arrays may be longer than `nEvents * channels` (frames have a capacity); only the first
+ * `nEvents * channels` values are read or written.
+ *
+ * Hot path: every kernel owns scratch buffers inside the wasm memory. `process` copies the input
+ * into the input scratch through a cached `Float64Array` view of the memory, runs the kernel and
+ * copies the output scratch out. Nothing is allocated per call in steady state; capacity grows
+ * (doubling) only when a call brings more events than ever before. The view is re-created when
+ * the wasm memory grows (its old buffer is then detached and reads as length 0).
+ */
+
+import {
+  initSync,
+  version,
+  wasm_memory,
+  WasmEmgSynth,
+  WasmFilterBank,
+  WasmFunctionKernel,
+} from "../../../core-wasm/pkg/mosaic_core.js";
+
+/**
+ * A compiled `WebAssembly.Module`. Typed opaquely because the engine layer is type-checked
+ * without the DOM and webworker libraries, which are the ones that declare `WebAssembly`.
+ */
+export type WasmModuleLike = object;
+
+/** What `initDsp` accepts: the `.wasm` bytes (`BufferSource`) or a compiled module. */
+export type DspWasmSource = ArrayBuffer | ArrayBufferView | WasmModuleLike;
+
+interface WasmMemoryLike {
+  readonly buffer: ArrayBuffer;
+}
+
+let memory: WasmMemoryLike | null = null;
+/** View of the whole wasm memory; re-created when the memory grows. */
+let heap = new Float64Array(0);
+
+/** The heap view, re-created if the memory grew since it was made. */
+function f64(): Float64Array {
+  if (heap.byteLength === 0) heap = new Float64Array((memory as WasmMemoryLike).buffer);
+  return heap;
+}
+
+/** Events a new kernel's scratch buffers hold before the first call that needs more. */
+const INITIAL_CAPACITY = 64;
+
+/**
+ * Instantiates the DSP module synchronously (the `--target web` glue's `initSync`). Call once per
+ * thread before creating any kernel; later calls do nothing.
+ */
+export function initDsp(wasmBytes: DspWasmSource): void {
+  if (memory !== null) return;
+  try {
+    initSync({ module: wasmBytes });
+  } catch (e) {
+    throw new Error(
+      `initDsp: cannot instantiate the DSP module (${errorMessage(e)}); pass the bytes of ` +
+        "core-wasm/pkg/mosaic_core_bg.wasm or a compiled WebAssembly.Module, and rebuild it " +
+        "with `npm run build:wasm` if it is missing or stale",
+      { cause: e },
+    );
+  }
+  memory = wasm_memory() as WasmMemoryLike;
+  heap = new Float64Array(memory.buffer);
+}
+
+/** `true` once `initDsp` has succeeded in this thread. */
+export function dspReady(): boolean {
+  return memory !== null;
+}
+
+/** Version of the Rust core (`mosaic-core-wasm` crate). */
+export function dspVersion(): string {
+  requireReady("dspVersion()");
+  return version();
+}
+
+function requireReady(what: string): void {
+  if (memory === null) {
+    throw new Error(`${what} needs the DSP module: call initDsp(wasmBytes) first`);
+  }
+}
+
+function errorMessage(e: unknown): string {
+  return e instanceof Error ? e.message : String(e);
+}
+
+/** Rust constructor errors arrive as JS `Error`s carrying the Rust message; keep them. */
+function asError(e: unknown): Error {
+  return e instanceof Error ? e : new Error(String(e));
+}
+
+function checkChannels(what: string, channels: number): void {
+  if (!Number.isInteger(channels) || channels < 1 || channels > 0xffff) {
+    throw new Error(`${what}: channels must be an integer from 1 to 65535; got ${channels}`);
+  }
+}
+
+/**
+ * Validates a call's event count and array lengths; `b` may be `a` or omitted (`null`). Nothing
+ * is allocated unless it throws.
+ */
+function checkCall(
+  what: string,
+  nEvents: number,
+  channels: number,
+  a: ArrayLike<number>,
+  b: ArrayLike<number> | null,
+): void {
+  const n = nEvents * channels;
+  if (!(
+    nEvents >= 0 &&
+    Number.isInteger(nEvents) &&
+    a.length >= n &&
+    (b === null || b.length >= n)
+  )) {
+    if (!Number.isInteger(nEvents) || nEvents < 0) {
+      throw new Error(`${what}: nEvents must be a non-negative integer; got ${nEvents}`);
+    }
+    const [name, len] =
+      a.length < n
+        ? [b === null ? "output" : "input", a.length]
+        : ["output", (b as ArrayLike<number>).length];
+    throw new Error(
+      `${what}: ${name} has ${len} values but ${nEvents} events × ${channels} channels need ${n}`,
+    );
+  }
+}
+
+function failed(what: string): Error {
+  return new Error(`${what}: the wasm kernel refused the call (capacity out of step)`);
+}
+
+/** Up to this many values a plain loop is the fastest copy; above, `TypedArray.set`. */
+const LOOP_MAX = 8;
+/** Views cached per scratch buffer (one per distinct batch size seen). */
+const VIEW_CACHE_MAX = 32;
+
+/**
+ * Prefix views `src.subarray(0, n)` of callers' arrays that are much longer than the batch
+ * (pooled frames have a capacity), cached per array and per `n`: a stream of batches of recurring
+ * sizes through the same frames copies with `set` and never allocates. Weak, so frames are not
+ * kept alive by the cache.
+ */
+const prefixes = new WeakMap<Float64Array, Map<number, Float64Array>>();
+/** Below this many values a loop costs less than the two cache look-ups of `prefix`. */
+const PREFIX_MIN = 64;
+
+function prefix(src: Float64Array, n: number): Float64Array {
+  let byN = prefixes.get(src);
+  if (byN === undefined) {
+    byN = new Map();
+    prefixes.set(src, byN);
+  }
+  let v = byN.get(n);
+  if (v === undefined || v.length !== n) {
+    if (byN.size >= VIEW_CACHE_MAX) byN.clear();
+    v = src.subarray(0, n);
+    byN.set(n, v);
+  }
+  return v;
+}
+
+/**
+ * One scratch buffer inside the wasm memory (a kernel's input, output or operand buffer).
+ *
+ * Copies use `TypedArray.set` (several times faster than an element loop, even for 32 values),
+ * into the heap directly (from a cached prefix view when the source is much longer than the
+ * batch) and out of the heap through a view of exactly `n` values. Those views are cached per
+ * `n` and dropped when the buffer moves or the memory grows, so a stream of batches of recurring
+ * sizes never allocates.
+ */
+class Scratch {
+  /** Index (in f64 units) of the buffer in the heap. */
+  private at = 0;
+  /** Length of the buffer, in values. */
+  private len = 0;
+  private readonly views = new Map<number, Float64Array>();
+  /** The last view used (the common case: the same batch size as last time). */
+  private last: Float64Array = new Float64Array(0);
+
+  place(bytePtr: number, len: number): void {
+    this.at = bytePtr >>> 3;
+    this.len = len;
+    this.views.clear();
+    this.last = new Float64Array(0);
+  }
+
+  /** Copies `src[0..n)` into the buffer. */
+  write(src: ArrayLike<number>, n: number): void {
+    const h = f64();
+    const at = this.at;
+    if (n > LOOP_MAX && src instanceof Float64Array) {
+      const m = src.length;
+      // Copying some values past n is harmless when the buffer has room, and far cheaper
+      // than a loop as long as it is not much more than n.
+      if (m === n || (m <= this.len && m <= 2 * n)) {
+        h.set(src, at);
+        return;
+      }
+      if (n >= PREFIX_MIN) {
+        h.set(prefix(src, n), at);
+        return;
+      }
+    }
+    for (let i = 0; i < n; i++) h[at + i] = src[i] as number;
+  }
+
+  /** Copies the first `n` values of the buffer into `dst[0..n)`. */
+  read(dst: Float64Array, n: number): void {
+    if (n > LOOP_MAX) {
+      let v = this.last;
+      if (v.length !== n || v.byteLength === 0) {
+        v = this.views.get(n) ?? v;
+        if (v.length !== n || v.byteLength === 0) {
+          if (this.views.size >= VIEW_CACHE_MAX) this.views.clear();
+          v = new Float64Array(f64().buffer, this.at * 8, n);
+          this.views.set(n, v);
+        }
+        this.last = v;
+      }
+      dst.set(v);
+      return;
+    }
+    const h = f64();
+    const at = this.at;
+    for (let i = 0; i < n; i++) dst[i] = h[at + i] as number;
+  }
+}
+
+function disposed(what: string): Error {
+  return new Error(`${what} was used after dispose()`);
+}
+
+/** Capacity to grow to: at least `needed`, at least double the current one (amortised). */
+function grownCapacity(current: number, needed: number): number {
+  return Math.max(needed, current * 2);
+}
+
+/**
+ * The MOSAIC Filter block's kernel: the difference equation (paper eq. 1) applied to every
+ * channel independently, in direct form I. Coefficients are divided by `denominator[0]` (as
+ * `scipy.signal.lfilter`); `denominator = [1]` gives an FIR filter. Initial state is zero.
+ */
+export class FilterBank {
+  readonly channels: number;
+  private inner: WasmFilterBank | null;
+  private capacity = 0;
+  private readonly input = new Scratch();
+  private readonly output = new Scratch();
+
+  constructor(numerator: readonly number[], denominator: readonly number[], channels: number) {
+    requireReady("FilterBank");
+    checkChannels("FilterBank", channels);
+    try {
+      this.inner = new WasmFilterBank(
+        Float64Array.from(numerator),
+        Float64Array.from(denominator),
+        channels,
+        INITIAL_CAPACITY,
+      );
+    } catch (e) {
+      throw asError(e);
+    }
+    this.channels = channels;
+    this.locate();
+  }
+
+  private locate(): void {
+    const k = this.inner as WasmFilterBank;
+    this.capacity = k.capacity();
+    const len = this.capacity * this.channels;
+    this.input.place(k.input_ptr(), len);
+    this.output.place(k.output_ptr(), len);
+  }
+
+  /**
+   * Filters `nEvents` events of `input` into `output` (`nEvents * channels` values from index 0).
+   * `output` may be the same array as `input`.
+   */
+  process(input: Float64Array, output: Float64Array, nEvents: number): void {
+    const k = this.inner;
+    if (k === null) throw disposed("FilterBank");
+    const c = this.channels;
+    checkCall("FilterBank.process", nEvents, c, input, output);
+    if (nEvents > this.capacity) {
+      k.ensure_capacity(grownCapacity(this.capacity, nEvents));
+      this.locate();
+    }
+    const n = nEvents * c;
+    this.input.write(input, n);
+    if (!k.process(nEvents)) throw failed("FilterBank.process");
+    this.output.read(output, n);
+  }
+
+  /** Clears the filter history (back to the zero initial state). */
+  reset(): void {
+    if (this.inner === null) throw disposed("FilterBank");
+    this.inner.reset();
+  }
+
+  /** Frees the wasm memory of this bank. Further calls throw. Calling it twice is harmless. */
+  dispose(): void {
+    this.inner?.free();
+    this.inner = null;
+  }
+}
+
+/** The operations of the MOSAIC Function block (paper Table 1). */
+export type FunctionOperation = "add" | "multiply" | "abs" | "power" | "clip";
+
+export interface FunctionKernelOptions {
+  /** add / multiply: 1 value (every channel) or one value per channel. */
+  operand?: readonly number[];
+  /** power: the exponent (integers up to ±64 are exact products; 0.5 is sqrt; else `pow`). */
+  exponent?: number;
+  /** clip: lower bound (default −∞). */
+  min?: number;
+  /** clip: upper bound (default +∞). */
+  max?: number;
+}
+
+const OPERATIONS: readonly FunctionOperation[] = ["add", "multiply", "abs", "power", "clip"];
+
+/**
+ * The MOSAIC Function block's kernel: an element-wise operation. As in NumPy, a negative base
+ * with a non-integer exponent gives NaN and NaN passes through `clip`.
+ */
+export class FunctionKernel {
+  readonly channels: number;
+  readonly op: FunctionOperation;
+  private inner: WasmFunctionKernel | null;
+  private readonly takesOperand: boolean;
+  private capacity = 0;
+  private readonly input = new Scratch();
+  private readonly output = new Scratch();
+  private readonly operand = new Scratch();
+
+  constructor(op: FunctionOperation, options: FunctionKernelOptions, channels: number) {
+    requireReady("FunctionKernel");
+    checkChannels("FunctionKernel", channels);
+    if (!OPERATIONS.includes(op)) {
+      throw new Error(
+        `FunctionKernel: unknown operation '${String(op)}'; expected one of ${OPERATIONS.join(", ")}`,
+      );
+    }
+    if ((op === "add" || op === "multiply") && options.operand === undefined) {
+      throw new Error(
+        `FunctionKernel '${op}' needs options.operand (1 value, or one value per channel)`,
+      );
+    }
+    if (op === "power" && options.exponent === undefined) {
+      throw new Error("FunctionKernel 'power' needs options.exponent");
+    }
+    try {
+      this.inner = new WasmFunctionKernel(
+        op,
+        Float64Array.from(options.operand ?? []),
+        options.exponent ?? Number.NaN,
+        options.min ?? -Infinity,
+        options.max ?? Infinity,
+        channels,
+        INITIAL_CAPACITY,
+      );
+    } catch (e) {
+      throw asError(e);
+    }
+    this.op = op;
+    this.channels = channels;
+    this.takesOperand = this.inner.takes_operand();
+    this.locate();
+  }
+
+  private locate(): void {
+    const k = this.inner as WasmFunctionKernel;
+    this.capacity = k.capacity();
+    const len = this.capacity * this.channels;
+    this.input.place(k.input_ptr(), len);
+    this.output.place(k.output_ptr(), len);
+    this.operand.place(k.operand_ptr(), this.channels);
+  }
+
+  private prepare(
+    what: string,
+    nEvents: number,
+    input: Float64Array,
+    output: Float64Array,
+  ): WasmFunctionKernel {
+    const k = this.inner;
+    if (k === null) throw disposed("FunctionKernel");
+    checkCall(what, nEvents, this.channels, input, output);
+    if (nEvents > this.capacity) {
+      k.ensure_capacity(grownCapacity(this.capacity, nEvents));
+      this.locate();
+    }
+    return k;
+  }
+
+  /** Applies the operation with its constant operand. `output` may be `input`. */
+  process(input: Float64Array, output: Float64Array, nEvents: number): void {
+    const k = this.prepare("FunctionKernel.process", nEvents, input, output);
+    const n = nEvents * this.channels;
+    this.input.write(input, n);
+    if (!k.process(nEvents)) throw failed("FunctionKernel.process");
+    this.output.read(output, n);
+  }
+
+  /**
+   * add / multiply with an operand from another stream: `operand` holds `channels` values,
+   * applied to every event of this call.
+   */
+  processWithOperand(
+    input: Float64Array,
+    operand: Float64Array,
+    output: Float64Array,
+    nEvents: number,
+  ): void {
+    if (!this.takesOperand) {
+      throw new Error(
+        `FunctionKernel: operation '${this.op}' takes no operand; only 'add' and 'multiply' do ` +
+          "(call process instead)",
+      );
+    }
+    const c = this.channels;
+    if (operand.length < c) {
+      throw new Error(
+        `FunctionKernel.processWithOperand: operand has ${operand.length} values; expected ` +
+          `${c} (one per channel)`,
+      );
+    }
+    const k = this.prepare("FunctionKernel.processWithOperand", nEvents, input, output);
+    const n = nEvents * c;
+    this.input.write(input, n);
+    this.operand.write(operand, c);
+    if (!k.process_with_operand(nEvents)) throw failed("FunctionKernel.processWithOperand");
+    this.output.read(output, n);
+  }
+
+  /** Does nothing (the operation has no state); present for a uniform kernel interface. */
+  reset(): void {
+    if (this.inner === null) throw disposed("FunctionKernel");
+    this.inner.reset();
+  }
+
+  /** Frees the wasm memory of this kernel. Further calls throw. */
+  dispose(): void {
+    this.inner?.free();
+    this.inner = null;
+  }
+}
+
+/** Configuration of an `EmgSynth`; omitted fields take the values of `EMG_SYNTH_DEFAULTS`. */
+export interface EmgSynthConfig {
+  channels: number;
+  /** Hz. */
+  sampleRate: number;
+  /** Integer from 0 to 2^53 − 1 (passed to Rust as a 64-bit seed). */
+  seed: number;
+  /** RMS of the EMG at full activation, mV. */
+  amplitudeMv?: number;
+  /** RMS of the white background noise, mV. */
+  noiseFloorMv?: number;
+  /** Amplitude of the powerline interference, mV. */
+  humMv?: number;
+  /** Powerline frequency, Hz. */
+  humHz?: number;
+  /** High-pass corner of the EMG band, Hz (0: none). */
+  bandLowHz?: number;
+  /** Low-pass corner of the EMG band, Hz (clamped to 0.45 × sampleRate). */
+  bandHighHz?: number;
+  /** Envelope time constant when the activation rises, ms. */
+  attackMs?: number;
+  /** Envelope time constant when the activation falls, ms. */
+  releaseMs?: number;
+  /** Relative depth of the slow 1–3 Hz amplitude fluctuation, 0..1. */
+  modulation?: number;
+}
+
+/** Defaults of the optional `EmgSynthConfig` fields (same as Rust `EmgSynthConfig::new`). */
+export const EMG_SYNTH_DEFAULTS = {
+  amplitudeMv: 0.5,
+  noiseFloorMv: 0.01,
+  humMv: 0.02,
+  humHz: 50,
+  bandLowHz: 20,
+  bandHighHz: 450,
+  attackMs: 60,
+  releaseMs: 150,
+  modulation: 0.1,
+} as const;
+
+/**
+ * Seeded multi-channel surface-EMG generator (the EmgSimulator block's kernel): band-limited
+ * Gaussian noise shaped by an attack/release envelope that follows per-channel target
+ * activations, plus a noise floor and powerline hum. Same seed, same output.
+ */
+export class EmgSynth {
+  readonly channels: number;
+  private inner: WasmEmgSynth | null;
+  private capacity = 0;
+  private readonly output = new Scratch();
+  private readonly targets = new Scratch();
+
+  constructor(config: EmgSynthConfig) {
+    requireReady("EmgSynth");
+    checkChannels("EmgSynth", config.channels);
+    const seed = config.seed;
+    if (!Number.isSafeInteger(seed) || seed < 0) {
+      throw new Error(`EmgSynth: seed must be an integer from 0 to 2^53 - 1; got ${seed}`);
+    }
+    const c = { ...EMG_SYNTH_DEFAULTS, ...config };
+    try {
+      this.inner = new WasmEmgSynth(
+        c.channels,
+        c.sampleRate,
+        Math.floor(seed / 0x1_0000_0000),
+        seed % 0x1_0000_0000,
+        c.amplitudeMv,
+        c.noiseFloorMv,
+        c.humMv,
+        c.humHz,
+        c.bandLowHz,
+        c.bandHighHz,
+        c.attackMs,
+        c.releaseMs,
+        c.modulation,
+        INITIAL_CAPACITY,
+      );
+    } catch (e) {
+      throw asError(e);
+    }
+    this.channels = config.channels;
+    this.locate();
+  }
+
+  private locate(): void {
+    const k = this.inner as WasmEmgSynth;
+    this.capacity = k.capacity();
+    this.output.place(k.output_ptr(), this.capacity * this.channels);
+    this.targets.place(k.targets_ptr(), this.channels);
+  }
+
+  /** Target activation per channel (`channels` values, clamped to 0..1; NaN is an error). */
+  setTargets(targets: ArrayLike<number>): void {
+    const k = this.inner;
+    if (k === null) throw disposed("EmgSynth");
+    const c = this.channels;
+    if (targets.length !== c) {
+      throw new Error(
+        `EmgSynth.setTargets: got ${targets.length} values; expected ${c} (one per channel)`,
+      );
+    }
+    this.targets.write(targets, c);
+    try {
+      k.apply_targets();
+    } catch (e) {
+      throw asError(e);
+    }
+  }
+
+  /** Writes `nEvents` events (`nEvents * channels` values from index 0) into `output`. */
+  generate(output: Float64Array, nEvents: number): void {
+    const k = this.inner;
+    if (k === null) throw disposed("EmgSynth");
+    checkCall("EmgSynth.generate", nEvents, this.channels, output, null);
+    if (nEvents > this.capacity) {
+      k.ensure_capacity(grownCapacity(this.capacity, nEvents));
+      this.locate();
+    }
+    if (!k.generate(nEvents)) throw failed("EmgSynth.generate");
+    this.output.read(output, nEvents * this.channels);
+  }
+
+  /** Back to the initial state (time 0, same random streams); the targets are kept. */
+  reset(): void {
+    if (this.inner === null) throw disposed("EmgSynth");
+    this.inner.reset();
+  }
+
+  /** Frees the wasm memory of this generator. Further calls throw. */
+  dispose(): void {
+    this.inner?.free();
+    this.inner = null;
+  }
+}

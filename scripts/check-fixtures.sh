@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# Regenerates every reference fixture into a temporary folder with the pinned
+# Python environment (tests/reference, managed by uv) and compares it byte for
+# byte with the committed fixture, so the committed generators provably produce
+# the committed fixtures. Exit 0 when all match, 1 on a mismatch, 2 when the
+# environment cannot be set up.
+# Usage: bash scripts/check-fixtures.sh   (from any directory)
+set -euo pipefail
+
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+PROJECT="$ROOT/tests/reference"
+
+# Generator script -> the fixture files it writes (relative to the script's folder).
+GENERATORS=(
+  "core-wasm/dsp/tests/fixtures/gen_lfilter.py:lfilter.json"
+  "core-wasm/dsp/tests/fixtures/gen_function.py:function.json"
+)
+
+# uv as installed by scripts/setup.sh (pip --user: `python3 -m uv`), or on PATH.
+want_uv="$(tr -d '[:space:]' <"$PROJECT/UV_VERSION")"
+if python3 -m uv --version >/dev/null 2>&1; then
+  UV=(python3 -m uv)
+elif command -v uv >/dev/null 2>&1; then
+  UV=(uv)
+elif [[ -x "$HOME/.local/bin/uv" ]]; then
+  UV=("$HOME/.local/bin/uv")
+else
+  echo "check-fixtures: error: uv is not installed; run 'npm run setup' (or: python3 -m pip install --user 'uv==$want_uv')." >&2
+  exit 2
+fi
+have_uv="$("${UV[@]}" --version 2>/dev/null | awk '{print $2}')"
+if [[ "$have_uv" != "$want_uv" ]]; then
+  echo "check-fixtures: warning: uv $have_uv found, tests/reference/UV_VERSION pins $want_uv." >&2
+fi
+
+TMP="$(mktemp -d)"
+trap 'rm -rf "$TMP"' EXIT
+
+# --frozen: use uv.lock as committed (fail rather than re-resolve).
+run_py() {
+  PYTHONDONTWRITEBYTECODE=1 UV_PYTHON_DOWNLOADS=never "${UV[@]}" run --frozen --quiet --project "$PROJECT" --python python3.11 python "$@"
+}
+if ! run_py -c "import numpy, scipy" 2>"$TMP/setup.log"; then
+  cat "$TMP/setup.log" >&2
+  echo "check-fixtures: error: cannot set up the reference environment (tests/reference); see above." >&2
+  exit 2
+fi
+
+status=0
+for entry in "${GENERATORS[@]}"; do
+  script="${entry%%:*}"
+  outputs="${entry#*:}"
+  dir="$(dirname "$ROOT/$script")"
+  out="$TMP/$(basename "$script" .py)"
+  mkdir -p "$out"
+  if ! (cd "$ROOT" && run_py "$script" --out "$out"); then
+    echo "check-fixtures: FAIL: $script exited with an error." >&2
+    status=1
+    continue
+  fi
+  IFS=',' read -r -a files <<<"$outputs"
+  for f in "${files[@]}"; do
+    committed="$dir/$f"
+    if [[ ! -f "$committed" ]]; then
+      echo "check-fixtures: FAIL: ${committed#"$ROOT"/} is missing (run $script to create it)." >&2
+      status=1
+    elif cmp -s "$out/$f" "$committed"; then
+      echo "check-fixtures: ok   ${committed#"$ROOT"/} ($(wc -c <"$committed") bytes) is what $script produces"
+    else
+      echo "check-fixtures: FAIL: ${committed#"$ROOT"/} differs from what $script produces now:" >&2
+      diff <(tr ',' '\n' <"$committed") <(tr ',' '\n' <"$out/$f") | head -20 >&2 || true
+      echo "check-fixtures: regenerate with: UV_PYTHON_DOWNLOADS=never uv run --project tests/reference --python python3.11 python $script" >&2
+      echo "check-fixtures: (and review why the numbers changed before committing)" >&2
+      status=1
+    fi
+  done
+done
+
+if [[ $status == 0 ]]; then
+  echo "check-fixtures: all fixtures reproduce byte for byte"
+fi
+exit $status
