@@ -1,36 +1,45 @@
-// Bundles the Node entry points (CLI, engine worker, tools) into dist/ with esbuild.
-// The engine and blocks are plain TypeScript modules bundled into each entry.
+// Bundles the Node entry points into dist/ with esbuild.
+//  - product (CLI, engine worker): pure-JS packages bundled in (one file to compile, less memory);
+//    code that only some commands need (validation) is split into lazily loaded chunks.
+//  - tools (docs generator): packages stay in node_modules.
 import { build } from "esbuild";
-import { copyFileSync, existsSync, mkdirSync } from "node:fs";
+import { copyFileSync, existsSync, mkdirSync, rmSync } from "node:fs";
 import { dirname, join } from "node:path";
 import { fileURLToPath } from "node:url";
 
 const root = join(dirname(fileURLToPath(import.meta.url)), "..");
+const present = (entries) =>
+  Object.fromEntries(Object.entries(entries).filter(([, src]) => existsSync(join(root, src))));
 
-/** entry (repo-relative) → output (dist-relative, .mjs) */
-export const entries = {
-  "app/cli/main.ts": "cli.mjs",
-  "app/host/engine.worker.ts": "engine.worker.mjs",
-  "tools/gen-docs.ts": "tools/gen-docs.mjs",
-};
-
-const present = Object.entries(entries).filter(([src]) => existsSync(join(root, src)));
-await build({
+const common = {
   absWorkingDir: root,
-  entryPoints: Object.fromEntries(present.map(([src, out]) => [out.replace(/\.mjs$/, ""), src])),
-  outdir: "dist",
-  outExtension: { ".js": ".mjs" },
   bundle: true,
   platform: "node",
   target: "node20",
   format: "esm",
+  outExtension: { ".js": ".mjs" },
   sourcemap: "linked",
   logLevel: "warning",
-  // Packages stay in node_modules (native modules cannot be bundled; keeps dist small).
-  packages: "external",
   banner: {
     js: "import { createRequire as __cr } from 'node:module'; const require = __cr(import.meta.url);",
   },
+};
+
+rmSync(join(root, "dist/chunks"), { recursive: true, force: true });
+await build({
+  ...common,
+  entryPoints: present({ cli: "app/cli/main.ts", "engine.worker": "app/host/engine.worker.ts" }),
+  outdir: "dist",
+  splitting: true,
+  chunkNames: "chunks/[name]-[hash]",
+  // Native modules cannot be bundled.
+  external: ["serialport", "@serialport/*", "@abandonware/noble", "electron"],
+});
+await build({
+  ...common,
+  entryPoints: present({ "tools/gen-docs": "tools/gen-docs.ts" }),
+  outdir: "dist",
+  packages: "external",
 });
 
 const wasm = join(root, "core-wasm/pkg/mosaic_core_bg.wasm");

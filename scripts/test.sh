@@ -3,20 +3,21 @@
 # integration tests. This is what CI runs (.ci/run).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+bin=node_modules/.bin
 step() { printf '\n\033[1m== %s\033[0m\n' "$*"; }
 
 step "setup and build"
 bash scripts/setup.sh
 
 step "lint (eslint, with the layering rule)"
-npx eslint --max-warnings 0 .
+"$bin/eslint" --max-warnings 0 .
 
 step "format (prettier)"
-npx prettier --check . >/dev/null || { npx prettier --check . ; exit 1; }
+"$bin/prettier" --check --log-level warn .
 
 step "types (tsc, per runtime layer)"
-npx tsc -p tsconfig.pure.json
-npx tsc -p tsconfig.node.json
+"$bin/tsc" -p tsconfig.pure.json
+"$bin/tsc" -p tsconfig.node.json
 
 step "rust (fmt, clippy, tests)"
 cargo fmt --manifest-path core-wasm/Cargo.toml --all -- --check
@@ -27,6 +28,6 @@ step "reference fixtures are reproduced by their committed generators"
 bash scripts/check-fixtures.sh
 
 step "unit and integration tests (vitest)"
-npx vitest run
+"$bin/vitest" run
 
 printf '\n\033[1;32mall tests passed\033[0m\n'

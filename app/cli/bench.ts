@@ -1,5 +1,712 @@
-/** `mosaic bench`: the standard performance suite (filled in below). */
-export async function runBench(_args: string[]): Promise<number> {
-  process.stderr.write("mosaic bench: not built yet\n");
-  return 1;
+/**
+ * `mosaic bench`: the standard performance suite (DESIGN.md §6), measured like the paper's
+ * section V. Every workload runs the real product, `mosaic run … --json`, as a child process
+ * (the bundled dist/cli.mjs next to this bundle) and is measured from outside: CPU and memory from
+ * /proc once a second, timing (the paper's Table 5) and status shares (Table 6) from the child's
+ * JSON lines. Prints Markdown tables as workloads finish and writes bench/results/latest.json and
+ * latest.md. See bench/README.md.
+ */
+import { execFileSync } from "node:child_process";
+import {
+  existsSync,
+  mkdirSync,
+  mkdtempSync,
+  readFileSync,
+  renameSync,
+  rmSync,
+  writeFileSync,
+} from "node:fs";
+import { cpus, loadavg, release, tmpdir, totalmem } from "node:os";
+import { dirname, join, relative, resolve } from "node:path";
+import { fileURLToPath } from "node:url";
+import { parseArgs } from "node:util";
+import type { BlockTelemetry, Telemetry } from "../engine/runtime/runtime";
+import { writeEmgCsv, writeReplayPipeline } from "./bench-data";
+import {
+  measureWakeFloor,
+  clkTck,
+  mean,
+  quantile,
+  runChild,
+  schedstatAvailable,
+  std,
+  type ChildRun,
+} from "./bench-proc";
+import {
+  load,
+  pipelineMarkdown,
+  replayMarkdown,
+  targets,
+  targetsTable,
+  type BlockRow,
+  type CpuFigures,
+  type PipelineResult,
+  type ReplayResult,
+  type TargetRow,
+  type WorkloadResult,
+} from "./bench-report";
+
+const HELP = `mosaic bench — the standard performance suite (DESIGN.md §6, paper section V)
+
+Usage:
+  mosaic bench [--duration S] [--warmup S] [--only NAME[,NAME]] [--out DIR] [--quick]
+
+Runs each workload as a child \`mosaic run … --json\` and measures it from outside (CPU and RSS
+from /proc every second; ΔT statistics and status shares from the run's telemetry). Prints
+Markdown tables and writes DIR/latest.json and DIR/latest.md (default DIR: bench/results).
+
+  --duration S  steady-state seconds per pipeline after the warm-up (default 30; the timer
+                workloads use half, at least 2)
+  --warmup S    seconds excluded at the start of each real-time run (default 5)
+  --only LIST   run only these workloads: ${"myo, delsys, hdemg, timer, timer-precision, replay-32, replay-256"}
+                (a prefix before '-' selects a group: timer, replay)
+  --out DIR     where to write latest.json and latest.md
+  --quick       a smoke test: 1 s warm-up, 3 s steady state, short replays (about 40 s in all)
+
+Exit 0 when every selected workload ran (missed targets are reported, not an error), 1 when one
+failed to run, 2 on bad options.
+`;
+
+interface PipelineDef {
+  kind: "pipeline";
+  id: string;
+  title: string;
+  file: string;
+  paper?: "myo" | "delsys";
+  extra?: string[];
+  /** The timer workloads run for half the steady-state duration. */
+  short?: boolean;
+}
+interface ReplayDef {
+  kind: "replay";
+  id: string;
+  title: string;
+  channels: number;
+  rate: number;
+  recordingSeconds: number;
+}
+type WorkloadDef = PipelineDef | ReplayDef;
+
+const WORKLOADS: WorkloadDef[] = [
+  {
+    kind: "pipeline",
+    id: "myo",
+    title: "(a) Myo pipeline — 8 ch @ 200 Hz",
+    file: "myo.yaml",
+    paper: "myo",
+  },
+  {
+    kind: "pipeline",
+    id: "delsys",
+    title: "(b) Delsys pipeline — 32 ch @ 1926 Hz",
+    file: "delsys.yaml",
+    paper: "delsys",
+  },
+  {
+    kind: "pipeline",
+    id: "hdemg",
+    title: "(c) High-density EMG — 256 ch @ 2048 Hz",
+    file: "hdemg.yaml",
+  },
+  {
+    kind: "pipeline",
+    id: "timer",
+    title: "Timer at 2 kHz, default mode",
+    file: "timer-2khz.yaml",
+    short: true,
+  },
+  {
+    kind: "pipeline",
+    id: "timer-precision",
+    title: "Timer at 2 kHz, --precision",
+    file: "timer-2khz.yaml",
+    extra: ["--precision"],
+    short: true,
+  },
+  {
+    kind: "replay",
+    id: "replay-32",
+    title: "Replay 32 ch @ 1926 Hz",
+    channels: 32,
+    rate: 1926,
+    recordingSeconds: 10,
+  },
+  {
+    kind: "replay",
+    id: "replay-256",
+    title: "Replay 256 ch @ 2048 Hz",
+    channels: 256,
+    rate: 2048,
+    recordingSeconds: 4,
+  },
+];
+
+/** The replay throughput target, channel-samples per second (DESIGN.md §6). */
+const REPLAY_TARGET = 20e6;
+
+function out(s = ""): void {
+  process.stdout.write(s + "\n");
+}
+function progress(s: string): void {
+  process.stderr.write(`bench: ${s}\n`);
+}
+
+/** dist/cli.mjs: this bundle itself when it is dist/cli.mjs, else the repository's dist. */
+function findCli(): string {
+  const here = fileURLToPath(import.meta.url);
+  if (here.endsWith(".mjs")) return join(dirname(here), "cli.mjs");
+  return join(findRoot(dirname(here)), "dist", "cli.mjs");
+}
+
+function findRoot(from: string): string {
+  let d = from;
+  for (let i = 0; i < 8; i++) {
+    if (existsSync(join(d, "package.json")) && existsSync(join(d, "pipelines"))) return d;
+    const up = dirname(d);
+    if (up === d) break;
+    d = up;
+  }
+  return process.cwd();
+}
+
+function cpuModel(): string {
+  try {
+    const m = /^model name\s*:\s*(.+)$/m.exec(readFileSync("/proc/cpuinfo", "utf8"));
+    if (m) return m[1]!.trim();
+  } catch {
+    // not Linux
+  }
+  return cpus()[0]?.model ?? "unknown";
+}
+
+function git(root: string, args: string[]): string | null {
+  try {
+    return execFileSync("git", args, {
+      cwd: root,
+      encoding: "utf8",
+      stdio: ["ignore", "pipe", "ignore"],
+    }).trim();
+  } catch {
+    return null;
+  }
+}
+
+const round = (x: number, d = 3): number => (Number.isFinite(x) ? Number(x.toFixed(d)) : x);
+const la = (): number[] => loadavg().map((x) => round(x, 2));
+
+function cpuFigures(run: ChildRun, useNs: boolean): CpuFigures | null {
+  const steady = run.samples.filter((s) => s.steady);
+  if (steady.length === 0) return null;
+  const pick = steady.map((s) => (useNs && Number.isFinite(s.nsPct) ? s.nsPct : s.ticksPct));
+  const ticks = steady.map((s) => s.ticksPct);
+  return {
+    source: useNs ? "schedstat" : "stat",
+    samples: steady.length,
+    medianPct: round(quantile(pick, 0.5)),
+    p90Pct: round(quantile(pick, 0.9)),
+    meanPct: round(mean(pick)),
+    stdPct: round(std(pick)),
+    ticksMedianPct: round(quantile(ticks, 0.5)),
+    ticksMeanPct: round(mean(ticks)),
+    clkTck: clkTck(),
+    threads: run.threads
+      .filter((t) => t.pct >= 0.05)
+      .map((t) => ({ thread: t.main ? "main" : `tid ${t.tid}`, pct: round(t.pct) })),
+    trace: run.samples.map((s) => ({
+      t: round(s.t, 2),
+      pct: round(useNs && Number.isFinite(s.nsPct) ? s.nsPct : s.ticksPct),
+      ticksPct: round(s.ticksPct),
+      rssMiB: round(s.rssKiB / 1024, 1),
+      steady: s.steady,
+    })),
+  };
+}
+
+function blockRows(run: ChildRun): BlockRow[] {
+  const s = run.summary!;
+  const base = new Map<string, BlockTelemetry>(
+    (run.baseline?.blocks ?? []).map((b) => [b.name, b]),
+  );
+  return s.blocks.map((b) => {
+    const c = run.statusCounts.get(b.name);
+    const n = run.telemetryLines;
+    const tm = b.timing;
+    const meanDt = tm.meanDt ?? NaN;
+    return {
+      name: b.name,
+      type: b.type,
+      desiredRate: b.desiredRate,
+      n: tm.n,
+      meanDt,
+      freq: meanDt > 0 ? 1 / meanDt : NaN,
+      stdDt: tm.stdDt ?? NaN,
+      computeMeanUs: tm.calls > 0 ? (tm.computeTotalMs / tm.calls) * 1000 : NaN,
+      calls: tm.calls,
+      dropsIn: b.dropsIn - (base.get(b.name)?.dropsIn ?? 0),
+      shares:
+        c && n > 0
+          ? {
+              ontime: (c.ontime / n) * 100,
+              idle: (c.idle / n) * 100,
+              lagging: (c.lagging / n) * 100,
+              stumbling: (c.stumbling / n) * 100,
+            }
+          : null,
+    };
+  });
+}
+
+function edgeDrops(t: Telemetry | undefined): number {
+  return (t?.edges ?? []).reduce((s, e) => s + e.dropped, 0);
+}
+
+async function runPipeline(
+  def: PipelineDef,
+  o: { cli: string; root: string; warmup: number; steady: number; useNs: boolean },
+): Promise<PipelineResult> {
+  const file = relative(o.root, join(o.root, "pipelines", "bench", def.file));
+  const total = o.warmup + o.steady + 0.5;
+  const args = [
+    "run",
+    file,
+    "--json",
+    "--duration",
+    String(total),
+    "--warmup",
+    String(o.warmup),
+    ...(def.extra ?? []),
+  ];
+  const before = la();
+  progress(`${def.id}: ${def.title} (${total} s)`);
+  const run = await runChild({
+    cli: o.cli,
+    args,
+    cwd: o.root,
+    steadySeconds: o.steady,
+    warmup: o.warmup > 0,
+    timeoutSeconds: total + 60,
+  });
+  const after = la();
+  const base: PipelineResult = {
+    kind: "pipeline",
+    id: def.id,
+    title: def.title,
+    ...(def.paper ? { paper: def.paper } : {}),
+    file,
+    args,
+    ok: run.ok,
+    ...(run.error ? { error: run.error } : {}),
+    warmupSeconds: o.warmup,
+    steadySeconds: o.steady,
+    measuredSeconds: NaN,
+    cpu: null,
+    blocksComputePct: NaN,
+    memory: null,
+    blocks: [],
+    timers: [],
+    drops: 0,
+    dropsAllTime: 0,
+    telemetryLines: run.telemetryLines,
+    loadAvgBefore: before,
+    loadAvgAfter: after,
+    loadSeconds: round(run.loadSeconds),
+    lingerSeconds: round(run.lingerSeconds),
+    killedAfterSummary: run.killedAfterSummary,
+    warnings: run.events
+      .filter((e) => e.level !== "info")
+      .map((e) => `${e.level}: ${e.block}: ${e.message}`),
+  };
+  if (!run.summary) return base;
+  const s = run.summary;
+  const baseline = new Map<string, BlockTelemetry>(
+    (run.baseline?.blocks ?? []).map((b) => [b.name, b]),
+  );
+  base.measuredSeconds = round(s.measuredSeconds);
+  base.cpu = cpuFigures(run, o.useNs);
+  const steadyRss = run.samples.filter((x) => x.steady).map((x) => x.rssKiB / 1024);
+  base.memory = {
+    peakRssMiB: round(run.peakRssKiB / 1024, 1),
+    steadyRssMedianMiB: round(quantile(steadyRss, 0.5), 1),
+  };
+  base.blocks = blockRows(run);
+  base.blocksComputePct = round(
+    (s.blocks.reduce((acc, b) => acc + (b.timing.computeTotalMs ?? 0), 0) /
+      (s.measuredSeconds * 1000)) *
+      100,
+  );
+  base.timers = s.blocks
+    .filter((b) => b.timer && b.type === "ScheduledTimer")
+    .map((b) => {
+      const t = b.timer!;
+      const b0 = baseline.get(b.name)?.timer;
+      return {
+        name: b.name,
+        desiredRate: b.desiredRate,
+        fired: t.fired - (b0?.fired ?? 0),
+        missed: t.missed - (b0?.missed ?? 0),
+        latenessP50Us: t.latenessP50Us,
+        latenessP99Us: t.latenessP99Us,
+        latenessMaxUs: round(t.latenessMaxUs, 1),
+      };
+    });
+  base.dropsAllTime = edgeDrops(s);
+  base.drops = base.dropsAllTime - edgeDrops(run.baseline);
+  if (o.warmup > 0 && !run.baseline) {
+    base.ok = false;
+    base.error = "no warmup-done line (does `mosaic run` support --warmup?)";
+  }
+  if (run.telemetryLines === 0 && base.ok) {
+    base.ok = false;
+    base.error = "no telemetry received during the steady state";
+  }
+  return base;
+}
+
+async function runReplay(
+  def: ReplayDef,
+  o: { cli: string; root: string; tmp: string; quick: boolean; targetWall: number },
+): Promise<ReplayResult> {
+  const csvName = `rec-${def.channels}ch-${def.rate}hz.csv`;
+  progress(
+    `${def.id}: generating a ${def.channels}-channel ${def.recordingSeconds}-s recording at ${def.rate} Hz`,
+  );
+  const { bytes } = await writeEmgCsv(
+    join(o.tmp, csvName),
+    def.channels,
+    def.rate,
+    def.recordingSeconds,
+    def.channels,
+  );
+  const template = join(o.root, "pipelines", "bench", "replay.yaml");
+  const pipe = writeReplayPipeline(
+    template,
+    o.tmp,
+    `replay-${def.channels}.yaml`,
+    csvName,
+    def.rate,
+  );
+  const perVirtualSecond = def.channels * def.rate;
+  const before = la();
+  const attempt = async (virtualSeconds: number) => {
+    const args = [
+      "run",
+      pipe,
+      "--json",
+      "--clock",
+      "virtual",
+      "--duration",
+      String(virtualSeconds),
+    ];
+    const run = await runChild({
+      cli: o.cli,
+      args,
+      cwd: o.root,
+      steadySeconds: 1e6,
+      warmup: false,
+      timeoutSeconds: 180,
+    });
+    const s = run.summary;
+    const source = s?.blocks.find((b) => b.type === "FilePlayer");
+    const samples = (source?.events ?? 0) * def.channels;
+    const wall = s?.wallSeconds ?? NaN;
+    let error = run.error;
+    if (!error && s && s.reason !== "finished") error = `run stopped: ${s.reason}`;
+    if (!error && !(samples > 0)) error = "the FilePlayer emitted nothing";
+    return {
+      run,
+      args,
+      virtualSeconds,
+      wall,
+      frames: source?.events ?? 0,
+      rate: samples / wall,
+      error,
+    };
+  };
+  let calibration: ReplayResult["calibration"];
+  let v = Math.max(5, Math.round((REPLAY_TARGET * o.targetWall) / perVirtualSecond));
+  if (!o.quick) {
+    const cal = Math.max(5, Math.round((REPLAY_TARGET * 0.5) / perVirtualSecond));
+    progress(`${def.id}: calibration, ${cal} virtual s`);
+    const c = await attempt(cal);
+    if (!c.error) {
+      calibration = {
+        virtualSeconds: cal,
+        wallSeconds: round(c.wall),
+        channelSamplesPerSecond: Math.round(c.rate),
+      };
+      v = Math.min(1e6, Math.max(cal, Math.round((c.rate * o.targetWall) / perVirtualSecond)));
+    }
+  }
+  progress(`${def.id}: ${v} virtual s`);
+  const m = await attempt(v);
+  const after = la();
+  return {
+    kind: "replay",
+    id: def.id,
+    title: def.title,
+    file: relative(o.root, template),
+    args: m.args.map((a) => (a === pipe ? `<tmp>/replay-${def.channels}.yaml` : a)),
+    ok: !m.error,
+    ...(m.error ? { error: m.error } : {}),
+    channels: def.channels,
+    rate: def.rate,
+    recordingSeconds: def.recordingSeconds,
+    recordingBytes: bytes,
+    virtualSeconds: v,
+    wallSeconds: round(m.wall, 4),
+    loadSeconds: round(m.run.loadSeconds),
+    channelSamplesPerSecond: Math.round(m.rate),
+    framesPerSecond: Math.round(m.frames / m.wall),
+    ...(calibration ? { calibration } : {}),
+    peakRssMiB: round(m.run.peakRssKiB / 1024, 1),
+    loadAvgBefore: before,
+    loadAvgAfter: after,
+    lingerSeconds: round(m.run.lingerSeconds),
+    killedAfterSummary: m.run.killedAfterSummary,
+  };
+}
+
+function writeAtomic(file: string, text: string): void {
+  const tmp = `${file}.tmp`;
+  writeFileSync(tmp, text);
+  renameSync(tmp, file);
+}
+
+function positive(name: string, v: string | undefined, dflt: number, allowZero = false): number {
+  if (v === undefined) return dflt;
+  const n = Number(v);
+  if (!(allowZero ? n >= 0 : n > 0) || !Number.isFinite(n)) {
+    throw new Error(
+      `--${name} must be a ${allowZero ? "non-negative" : "positive"} number of seconds, not '${v}'`,
+    );
+  }
+  return n;
+}
+
+export async function runBench(argv: string[]): Promise<number> {
+  let values;
+  try {
+    values = parseArgs({
+      args: argv,
+      allowPositionals: false,
+      options: {
+        duration: { type: "string" },
+        warmup: { type: "string" },
+        only: { type: "string" },
+        out: { type: "string" },
+        quick: { type: "boolean", default: false },
+        help: { type: "boolean", short: "h", default: false },
+      },
+    }).values;
+  } catch (e) {
+    process.stderr.write(`mosaic bench: ${(e as Error).message}\n${HELP}`);
+    return 2;
+  }
+  if (values.help) {
+    out(HELP);
+    return 0;
+  }
+  const quick = values.quick;
+  let steady: number;
+  let warmup: number;
+  try {
+    steady = Math.max(1, Math.floor(positive("duration", values.duration, quick ? 3 : 30)));
+    warmup = positive("warmup", values.warmup, quick ? 1 : 5, true);
+  } catch (e) {
+    process.stderr.write(`mosaic bench: ${(e as Error).message}\n`);
+    return 2;
+  }
+  let selected = WORKLOADS;
+  if (values.only !== undefined) {
+    const names = values.only
+      .split(",")
+      .map((s) => s.trim())
+      .filter(Boolean);
+    const unknown = names.filter(
+      (n) => !WORKLOADS.some((w) => w.id === n || w.id.startsWith(n + "-")),
+    );
+    if (unknown.length || names.length === 0) {
+      process.stderr.write(
+        `mosaic bench: unknown workload ${unknown.map((n) => `'${n}'`).join(", ") || "(none given)"}; ` +
+          `workloads: ${WORKLOADS.map((w) => w.id).join(", ")}\n`,
+      );
+      return 2;
+    }
+    selected = WORKLOADS.filter((w) => names.some((n) => w.id === n || w.id.startsWith(n + "-")));
+  }
+
+  const cli = findCli();
+  if (!existsSync(cli)) {
+    process.stderr.write(`mosaic bench: ${cli} not found; run node scripts/build-ts.mjs first\n`);
+    return 1;
+  }
+  const root = findRoot(dirname(cli));
+  const outDir = values.out !== undefined ? resolve(values.out) : join(root, "bench", "results");
+  const useNs = schedstatAvailable();
+  const started = new Date();
+  const t0 = performance.now();
+  const machine = {
+    node: process.version,
+    platform: `${process.platform} ${release()}`,
+    cpuModel: cpuModel(),
+    cores: cpus().length,
+    memoryGiB: round(totalmem() / 2 ** 30, 1),
+    clkTck: clkTck(),
+    cpuSource: useNs
+      ? "sum of /proc/<pid>/task/*/schedstat (ns)"
+      : `/proc/<pid>/stat utime+stime (${clkTck()} ticks/s)`,
+    loadAvgBefore: la(),
+    loadAvgAfter: [] as number[],
+    gitCommit: git(root, ["rev-parse", "HEAD"]),
+    gitDirty: (() => {
+      const s = git(root, ["status", "--porcelain"]);
+      return s === null ? null : s.length > 0;
+    })(),
+  };
+  out(`# MOSAIC benchmark (${quick ? "quick" : "full"})`);
+  out();
+  out(
+    `${started.toISOString()} · commit ${machine.gitCommit?.slice(0, 12) ?? "unknown"}${machine.gitDirty ? " (uncommitted changes)" : ""} · ` +
+      `Node ${machine.node} · ${machine.cpuModel}, ${machine.cores} cores · load average ${load(machine.loadAvgBefore)}`,
+  );
+  out();
+
+  const results: WorkloadResult[] = [];
+  let tmp: string | undefined;
+  try {
+    for (const def of selected) {
+      if (def.kind === "pipeline") {
+        const r = await runPipeline(def, {
+          cli,
+          root,
+          warmup,
+          steady: def.short ? Math.max(2, Math.ceil(steady / 2)) : steady,
+          useNs,
+        });
+        const rate = r.timers[0]?.desiredRate;
+        if (useNs && rate !== undefined && rate > 0 && !r.timers[0]!.name.startsWith("(")) {
+          progress(`${def.id}: wake-up floor, a bare worker sleeping at ${rate} Hz`);
+          r.wakeFloorPct = round(await measureWakeFloor(rate, quick ? 3 : 10));
+        }
+        results.push(r);
+        for (const l of pipelineMarkdown(r, "##")) out(l);
+      } else {
+        tmp ??= mkdtempSync(join(tmpdir(), "mosaic-bench-"));
+        const r = await runReplay(def, {
+          cli,
+          root,
+          tmp,
+          quick,
+          targetWall: quick ? 1 : 6,
+        });
+        results.push(r);
+        for (const l of replayMarkdown([r], "##")) out(l);
+      }
+    }
+  } finally {
+    if (tmp) rmSync(tmp, { recursive: true, force: true });
+  }
+  machine.loadAvgAfter = la();
+  const rows = targets(results);
+  const seconds = round((performance.now() - t0) / 1000, 1);
+  out("## Targets (DESIGN.md §6)");
+  out();
+  for (const l of targetsTable(rows)) out(l);
+  out();
+
+  const notMeasured = rows
+    .filter((r) => r.pass === null && r.value === null)
+    .map((r) => ({ id: r.id, workload: r.workload, reason: r.note }));
+  const lingering = results.filter((r) => r.killedAfterSummary);
+  const findings: string[] = [];
+  if (lingering.length) {
+    findings.push(
+      `${lingering.length} of ${results.length} \`mosaic run\` processes were still alive 1 s after ` +
+        "printing their summary and were terminated by the bench (SIGTERM). Nothing is lost (the " +
+        "summary is printed after the pipeline stopped and its logs were closed), but a finished " +
+        "run should exit at once.",
+    );
+  }
+  const json = {
+    schema: 1,
+    generatedAt: started.toISOString(),
+    suiteSeconds: seconds,
+    mode: quick ? "quick" : "full",
+    options: {
+      warmupSeconds: warmup,
+      steadySeconds: steady,
+      only: values.only ?? null,
+    },
+    machine,
+    targets: rows,
+    notMeasured,
+    findings,
+    workloads: results,
+  };
+  mkdirSync(outDir, { recursive: true });
+  writeAtomic(join(outDir, "latest.json"), JSON.stringify(json, null, 2) + "\n");
+  writeAtomic(join(outDir, "latest.md"), markdown(json, rows, results));
+  progress(
+    `done in ${seconds} s; wrote ${relative(process.cwd(), join(outDir, "latest.json"))} and latest.md`,
+  );
+  return results.every((r) => r.ok) ? 0 : 1;
+}
+
+function markdown(
+  json: {
+    generatedAt: string;
+    suiteSeconds: number;
+    mode: string;
+    options: { warmupSeconds: number; steadySeconds: number; only: string | null };
+    machine: {
+      node: string;
+      platform: string;
+      cpuModel: string;
+      cores: number;
+      memoryGiB: number;
+      cpuSource: string;
+      loadAvgBefore: number[];
+      loadAvgAfter: number[];
+      gitCommit: string | null;
+      gitDirty: boolean | null;
+    };
+    notMeasured: { id: string; workload: string; reason: string }[];
+    findings: string[];
+  },
+  rows: TargetRow[],
+  results: WorkloadResult[],
+): string {
+  const m = json.machine;
+  const lines: string[] = [
+    "# MOSAIC benchmark results",
+    "",
+    `Generated by \`mosaic bench${json.mode === "quick" ? " --quick" : ""}${json.options.only ? ` --only ${json.options.only}` : ""}\` ` +
+      `on ${json.generatedAt} in ${json.suiteSeconds} s. See bench/README.md for what each figure means.`,
+    "",
+    `- Commit: ${m.gitCommit ?? "unknown"}${m.gitDirty ? " (with uncommitted changes)" : ""}`,
+    `- Machine: ${m.cpuModel}, ${m.cores} cores (shared with other work), ${m.memoryGiB} GiB, ${m.platform}; Node ${m.node}`,
+    `- Load average (1/5/15 min): ${load(m.loadAvgBefore)} before, ${load(m.loadAvgAfter)} after`,
+    `- Warm-up ${json.options.warmupSeconds} s excluded per real-time run; steady state ${json.options.steadySeconds} s per pipeline (timer runs: half)`,
+    `- CPU: % of ONE core (100 % = one core busy), 1-s samples, ${m.cpuSource}. The paper gives % of an 8-core machine; its figures are converted to cores below.`,
+    "",
+    "## Targets (DESIGN.md §6) vs figures vs MOSAIC's paper",
+    "",
+    ...targetsTable(rows),
+    "",
+  ];
+  if (json.notMeasured.length) {
+    lines.push("## Not measured", "");
+    for (const n of json.notMeasured) lines.push(`- ${n.workload}: ${n.reason}`);
+    lines.push("");
+  }
+  if (json.findings.length) {
+    lines.push("## Findings", "");
+    for (const f of json.findings) lines.push(`- ${f}`);
+    lines.push("");
+  }
+  lines.push("## Pipelines (the paper's Tables 5 and 6)", "");
+  for (const r of results) if (r.kind === "pipeline") lines.push(...pipelineMarkdown(r, "###"));
+  const rs = results.filter((r): r is ReplayResult => r.kind === "replay");
+  if (rs.length) lines.push(...replayMarkdown(rs, "##"));
+  return lines.join("\n") + "\n";
 }

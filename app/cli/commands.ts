@@ -10,7 +10,6 @@ import { parseArgs } from "node:util";
 import { formatDiagnostic } from "../engine/diagnostics";
 import type { Telemetry } from "../engine/runtime/runtime";
 import { Host } from "../host/host";
-import { loadDspFromDisk, validatePipelineFile } from "../host/validate";
 import { runBench } from "./bench";
 import { renderTable } from "./table";
 
@@ -34,7 +33,8 @@ Usage:
         --log-dir DIR  base folder for relative Path logs (default: the pipeline's folder)
         --start T      virtual clock start time, UNIX seconds (default 0)
         --warmup S     reset the timing statistics (ΔT, lateness) after S seconds
-  mosaic bench [--duration S] [--only NAME[,NAME]] [--out DIR]
+        --telemetry-hz N  telemetry (status, rates) per second, default 20 (as the UI)
+  mosaic bench [--duration S] [--warmup S] [--only NAME[,NAME]] [--out DIR] [--quick]
       Runs the standard benchmarks and writes bench/results/*.json and *.md.
   mosaic --help | --version
 `;
@@ -51,6 +51,8 @@ async function cmdValidate(files: string[]): Promise<number> {
     err("mosaic validate: give at least one pipeline file");
     return 2;
   }
+  // Loaded on demand: `mosaic run` keeps the block catalog out of the main thread.
+  const { loadDspFromDisk, validatePipelineFile } = await import("../host/validate");
   loadDspFromDisk();
   let bad = false;
   for (const f of files) {
@@ -91,6 +93,7 @@ async function cmdRun(args: string[]): Promise<number> {
       "log-dir": { type: "string" },
       start: { type: "string" },
       warmup: { type: "string" },
+      "telemetry-hz": { type: "string" },
     },
   });
   const file = positionals[0];
@@ -118,6 +121,11 @@ async function cmdRun(args: string[]): Promise<number> {
     err(`mosaic run: --warmup must be a number of seconds, not '${values.warmup}'`);
     return 2;
   }
+  const telemetryHz = values["telemetry-hz"] !== undefined ? Number(values["telemetry-hz"]) : 20;
+  if (!(telemetryHz > 0 && telemetryHz <= 100)) {
+    err(`mosaic run: --telemetry-hz must be between 0 and 100, not '${values["telemetry-hz"]}'`);
+    return 2;
+  }
   const json = values.json;
   const tty = process.stdout.isTTY === true && !json;
   const color = tty && !process.env.NO_COLOR;
@@ -142,6 +150,7 @@ async function cmdRun(args: string[]): Promise<number> {
       precision: values.precision,
       ...(values["log-dir"] !== undefined ? { logDir: resolve(values["log-dir"]) } : {}),
       virtualStart: start,
+      telemetryHz,
       ...(mode === "virtual" && duration !== undefined ? { virtualDuration: duration } : {}),
     },
     {

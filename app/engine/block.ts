@@ -154,6 +154,11 @@ export interface BlockDefinition<S extends z.ZodType = z.ZodType> {
   inputs: InputSpec;
   /** Output port names; the first is the default. A function when ports depend on params. */
   outputs?: readonly string[] | ((params: z.output<S>) => readonly string[]);
+  /**
+   * True for blocks fed by I/O callbacks (sockets, serial ports, child processes): the worker that
+   * runs them then sleeps in its event loop between ticks, so that data wakes it at once.
+   */
+  eventLoop?: boolean;
   /** Timers drive pipelines: their ticks carry no values and `DesiredRate` is required. */
   timer?: boolean;
   /** True when the block needs `DesiredRate` written in the file. */

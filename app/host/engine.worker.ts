@@ -31,7 +31,7 @@ let loop: RealtimeLoop | undefined;
 let init: InitMessage | undefined;
 let vclock: VirtualClock | undefined;
 let stopped = false;
-const doorbellSab = new SharedArrayBuffer(4);
+const doorbellSab = new SharedArrayBuffer(8);
 const doorbell = new Int32Array(doorbellSab);
 const logRings: SabRing[] = [];
 

@@ -8,10 +8,8 @@ import { existsSync, readFileSync } from "node:fs";
 import { dirname, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
 import { Worker } from "node:worker_threads";
-import { catalog } from "../blocks/catalog";
 import { errorMessage, type Diagnostic } from "../engine/diagnostics";
 import { shapeSize } from "../engine/frame";
-import { loadPipeline } from "../engine/pipeline/loader";
 import type { Plan, RuntimeEvent, Telemetry } from "../engine/runtime/runtime";
 import { SabRing } from "../engine/runtime/sab-ring";
 import { LogWriter } from "./log-writer";
@@ -48,18 +46,28 @@ function repoRootFrom(here: string): string {
   return dirname(here);
 }
 
-/** dist/engine.worker.mjs next to the bundle, or the repo's dist when running from sources. */
-export function defaultWorkerPath(): string {
+/** A file of the bundle: next to this module, or one folder up (this module may be a chunk). */
+function distFile(name: string): string | undefined {
   const here = fileURLToPath(import.meta.url);
-  if (here.endsWith(".mjs")) return join(dirname(here), "engine.worker.mjs");
-  return join(repoRootFrom(here), "dist", "engine.worker.mjs");
+  if (!here.endsWith(".mjs")) return undefined;
+  for (const d of [dirname(here), dirname(dirname(here))]) {
+    if (existsSync(join(d, name))) return join(d, name);
+  }
+  return undefined;
+}
+
+/** dist/engine.worker.mjs of the running bundle, or the repo's dist when running from sources. */
+export function defaultWorkerPath(): string {
+  return (
+    distFile("engine.worker.mjs") ??
+    join(repoRootFrom(fileURLToPath(import.meta.url)), "dist", "engine.worker.mjs")
+  );
 }
 
 export function defaultWasmPath(): string {
-  const here = fileURLToPath(import.meta.url);
-  const nextTo = join(dirname(here), "mosaic_core_bg.wasm");
-  if (here.endsWith(".mjs") && existsSync(nextTo)) return nextTo;
-  const root = repoRootFrom(here);
+  const found = distFile("mosaic_core_bg.wasm");
+  if (found) return found;
+  const root = repoRootFrom(fileURLToPath(import.meta.url));
   const dist = join(root, "dist", "mosaic_core_bg.wasm");
   return existsSync(dist) ? dist : join(root, "core-wasm", "pkg", "mosaic_core_bg.wasm");
 }
@@ -131,8 +139,7 @@ export class Host {
         ],
       };
     }
-    const loaded = loadPipeline(source, file, catalog);
-    if (!loaded.spec) return { host: undefined, diagnostics: loaded.diagnostics };
+    // The main thread does not load the catalog: the main worker parses, validates and plans.
     const mode = opts.mode ?? "realtime";
     const host = new Host(file, {
       mode,
@@ -146,10 +153,6 @@ export class Host {
     });
     host.events = events;
     const timeBase = takeTimeBase();
-    const names =
-      mode === "virtual"
-        ? ["main"]
-        : ["main", ...new Set(loaded.spec.blocks.map((b) => b.worker).filter((w) => w !== "main"))];
     const diagnostics: Diagnostic[] = [];
     const init = (name: string, plan?: Plan) => ({
       type: "init" as const,
@@ -184,6 +187,10 @@ export class Host {
     diagnostics.push(...first.diagnostics);
     main.doorbell = first.doorbell;
     host.plan = first.plan;
+    const names =
+      mode === "virtual"
+        ? ["main"]
+        : ["main", ...new Set(first.plan.blocks.map((b) => b.worker).filter((w) => w !== "main"))];
     for (const name of names.slice(1)) {
       const w = host.spawn(name);
       const r = await host.request(
@@ -199,18 +206,22 @@ export class Host {
       w.doorbell = r.doorbell;
     }
     host.linkWorkers(
-      loaded.spec.blocks.map((b) => ({
+      first.plan.blocks.map((b) => ({
         name: b.name,
         worker: b.worker,
         inputs: b.inputs,
-        capacity: b.queue.capacity,
+        capacity: b.queueCapacity,
       })),
     );
     return { host, diagnostics };
   }
 
   private spawn(name: string): WorkerState {
-    const worker = new Worker(this.options.workerPath, { name: `mosaic-engine-${name}` });
+    const worker = new Worker(this.options.workerPath, {
+      name: `mosaic-engine-${name}`,
+      // A small young generation keeps the worker's footprint down; its garbage is tiny.
+      resourceLimits: { maxYoungGenerationSizeMb: 4 },
+    });
     const st: WorkerState = { name, worker, stopped: false, exited: false, waiters: [] };
     this.workers.set(name, st);
     worker.on("message", (m: WorkerToHost) => this.onMessage(st, m));
@@ -227,6 +238,17 @@ export class Host {
     return st;
   }
 
+  /** Posts a message and rings the worker's doorbell, so a worker blocked between ticks reads it now. */
+  private post(st: WorkerState, msg: HostToWorker): void {
+    st.worker.postMessage(msg);
+    if (st.doorbell) {
+      const bell = new Int32Array(st.doorbell);
+      Atomics.store(bell, 1, 1);
+      Atomics.add(bell, 0, 1);
+      Atomics.notify(bell, 0);
+    }
+  }
+
   private request(
     st: WorkerState,
     msg: HostToWorker,
@@ -240,7 +262,7 @@ export class Host {
         }
         return false;
       });
-      st.worker.postMessage(msg);
+      this.post(st, msg);
     });
   }
 
@@ -330,8 +352,7 @@ export class Host {
   }
 
   start(): void {
-    for (const w of this.workers.values())
-      w.worker.postMessage({ type: "start" } satisfies HostToWorker);
+    for (const w of this.workers.values()) this.post(w, { type: "start" } satisfies HostToWorker);
   }
 
   /** Merged telemetry of all workers (latest of each). */
@@ -361,7 +382,7 @@ export class Host {
           new Promise<{ ok: boolean; message: string }>((res) => {
             const id = this.nextReply++;
             this.replies.set(id, res);
-            w.worker.postMessage({ type: "control", id, ...op } as HostToWorker);
+            this.post(w, { type: "control", id, ...op } as HostToWorker);
           }),
       ),
     ).then((rs) => ({ ok: rs.every((r) => r.ok), message: rs.map((r) => r.message).join("; ") }));
@@ -375,10 +396,11 @@ export class Host {
         [...this.workers.values()].map((w) => {
           w.stopped = true;
           if (w.exited) return Promise.resolve();
+          let timer: NodeJS.Timeout | undefined;
           return Promise.race([
             this.request(w, { type: "stop" }, (m) => m.type === "stopped" || m.type === "fatal"),
-            new Promise((r) => setTimeout(r, timeoutMs)),
-          ]);
+            new Promise((r) => (timer = setTimeout(r, timeoutMs))),
+          ]).finally(() => clearTimeout(timer));
         }),
       );
       this.logWriter.closeAll();

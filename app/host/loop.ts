@@ -1,12 +1,19 @@
 /**
  * The real-time loop of an engine worker (DESIGN.md §3 Scheduling).
  *
- * Far from the next deadline the worker sleeps in its event loop (`Atomics.waitAsync` on its
- * doorbell, so I/O callbacks, control messages and frames from other workers wake it at once).
- * Within COARSE of the deadline it yields to the event loop once (I/O still runs every tick), then
- * blocks in `Atomics.wait` until slightly before the deadline — "slightly" is learned from the
- * observed wake-up overshoot so that ticks land on time without spinning. Precision mode spins the
- * last ~0.3 ms instead. Missed deadlines are skipped and counted by the scheduler, never burst.
+ * Between deadlines the worker blocks in `Atomics.wait` on its doorbell and wakes slightly before
+ * the deadline — "slightly" is learned from the observed wake-up overshoot, so ticks land on time
+ * without spinning; precision mode spins the last ~0.3 ms instead. Frames from other workers and
+ * control messages ring the doorbell, so they wake the worker at once. Missed deadlines are
+ * skipped and counted by the scheduler, never fired in a burst.
+ *
+ * Wake-ups are the main cost of a timer (on the 2-core VM of the benches a bare 2 kHz sleep loop
+ * costs ~4–5 % of a core, whatever the language), so the loop avoids extra ones:
+ * - a worker without I/O blocks yields to its event loop only when a control message is waiting,
+ *   or every YIELD_S, not after every tick;
+ * - a worker with I/O blocks (`eventLoop: true`, e.g. a UDP receiver) sleeps in its event loop
+ *   (`Atomics.waitAsync`) while the next deadline is far, so a datagram wakes it at once, and only
+ *   the last COARSE_S before a deadline are spent in `Atomics.wait`.
  */
 import type { Clock } from "../engine/clock";
 import type { Runtime } from "../engine/runtime/runtime";
@@ -14,11 +21,18 @@ import type { Runtime } from "../engine/runtime/runtime";
 const COARSE_S = 0.002;
 const PRECISION_SPIN_S = 0.0003;
 const MAX_MARGIN_S = 0.0002;
+/** Longest blocking wait, and longest time between event-loop turns, for workers without I/O. */
+const MAX_BLOCK_S = 0.02;
+const YIELD_S = 0.05;
+
+/** Doorbell slots: [0] bumped by anyone who wants the worker to look (data, control); [1] control messages waiting. */
+export const BELL_WAKE = 0;
+export const BELL_CONTROL = 1;
 
 export interface LoopOptions {
   runtime: Runtime;
   clock: Clock;
-  /** Int32Array over a SharedArrayBuffer: bumped + notified to wake this worker. */
+  /** Int32Array(2) over a SharedArrayBuffer (see BELL_WAKE, BELL_CONTROL). */
   doorbell: Int32Array;
   precision: boolean;
   telemetryIntervalS: number;
@@ -29,11 +43,15 @@ export interface LoopOptions {
 export class RealtimeLoop {
   private stopped = true;
   private lastTelemetry = -Infinity;
+  private lastYield = -Infinity;
   /** EWMA of how late Atomics.wait returns after its timeout (s). */
   private overshoot = 0.00006;
   private finishedReported = false;
+  private readonly eventLoop: boolean;
 
-  constructor(private readonly o: LoopOptions) {}
+  constructor(private readonly o: LoopOptions) {
+    this.eventLoop = o.runtime.needsEventLoop;
+  }
 
   get margin(): number {
     // Aim a little after the deadline rather than before it: ticks should not fire early.
@@ -44,7 +62,7 @@ export class RealtimeLoop {
     if (!this.stopped) return;
     this.stopped = false;
     this.lastTelemetry = this.o.clock.now();
-    setImmediate(this.tick);
+    setImmediate(this.turn);
   }
 
   stop(): void {
@@ -52,14 +70,18 @@ export class RealtimeLoop {
     this.wake();
   }
 
-  /** Re-plans the wait now (a timer started, a control message arrived, ...). */
+  /** Makes the loop look again now (a timer started, frames arrived, ...). */
   wake(): void {
-    Atomics.add(this.o.doorbell, 0, 1);
-    Atomics.notify(this.o.doorbell, 0);
+    Atomics.add(this.o.doorbell, BELL_WAKE, 1);
+    Atomics.notify(this.o.doorbell, BELL_WAKE);
   }
 
-  private readonly tick = (): void => {
-    if (this.stopped) return;
+  private nextDeadline(): number {
+    return Math.min(this.o.runtime.nextDeadline(), this.lastTelemetry + this.o.telemetryIntervalS);
+  }
+
+  /** Fires what is due, delivers, reports. */
+  private step(): void {
     const { runtime: rt, clock } = this.o;
     rt.scheduler.earlyTolerance = this.o.precision ? 0.000002 : this.margin + 0.000002;
     rt.step(clock.now());
@@ -72,49 +94,63 @@ export class RealtimeLoop {
       this.finishedReported = true;
       this.o.onFinished();
     }
-    this.plan();
-  };
-
-  private nextDeadline(): number {
-    return Math.min(this.o.runtime.nextDeadline(), this.lastTelemetry + this.o.telemetryIntervalS);
   }
 
-  private plan(): void {
-    if (this.stopped) return;
-    const bell = this.o.doorbell;
-    const seen = Atomics.load(bell, 0);
-    const remaining = this.nextDeadline() - this.o.clock.now();
-    if (remaining > COARSE_S) {
-      const r = Atomics.waitAsync(bell, 0, seen, (remaining - COARSE_S) * 1000);
-      if (r.async) r.value.then(this.tick, this.tick);
-      else setImmediate(this.tick);
-    } else {
-      setImmediate(this.fine);
-    }
-  }
-
-  private readonly fine = (): void => {
+  /** One turn of the event loop: step, then wait (blocking) until the loop must yield again. */
+  private readonly turn = (): void => {
     if (this.stopped) return;
     const { clock, doorbell } = this.o;
-    const deadline = this.nextDeadline();
-    const seen = Atomics.load(doorbell, 0);
-    if (this.o.precision) {
-      const sleep = deadline - PRECISION_SPIN_S - clock.now();
-      if (sleep > 0) Atomics.wait(doorbell, 0, seen, sleep * 1000);
-      while (clock.now() < deadline && Atomics.load(doorbell, 0) === seen) {
-        // spin: precision mode trades a little CPU for sub-10 µs ticks
+    this.lastYield = clock.now();
+    Atomics.store(doorbell, BELL_CONTROL, 0);
+    for (;;) {
+      this.step();
+      if (this.stopped) return;
+      const now = clock.now();
+      const remaining = this.nextDeadline() - now;
+      if (this.eventLoop && remaining > COARSE_S) {
+        // Sleep in the event loop so that I/O callbacks run as soon as data arrives.
+        const seen = Atomics.load(doorbell, BELL_WAKE);
+        const r = Atomics.waitAsync(doorbell, BELL_WAKE, seen, (remaining - COARSE_S) * 1000);
+        if (r.async) r.value.then(this.turn, this.turn);
+        else setImmediate(this.turn);
+        return;
       }
-    } else {
-      const target = deadline - this.margin;
-      const sleep = target - clock.now();
-      if (sleep > 0) {
-        const res = Atomics.wait(doorbell, 0, seen, sleep * 1000);
-        if (res === "timed-out") {
-          const over = clock.now() - target;
-          if (over >= 0 && over < 0.002) this.overshoot += 0.05 * (over - this.overshoot);
+      if (
+        Atomics.load(doorbell, BELL_CONTROL) !== 0 ||
+        now - this.lastYield >= (this.eventLoop ? 0 : YIELD_S)
+      ) {
+        setImmediate(this.turn);
+        if (remaining > 0.0005) return;
+        // A deadline is imminent: wait for it first, the event loop turns right after.
+        this.sleepUntilDeadline(MAX_BLOCK_S);
+        return;
+      }
+      this.sleepUntilDeadline(MAX_BLOCK_S);
+    }
+  };
+
+  /** Blocks until just before the next deadline (at most `maxS`) or until the doorbell rings. */
+  private sleepUntilDeadline(maxS: number): void {
+    const { clock, doorbell } = this.o;
+    const deadline = this.nextDeadline();
+    const seen = Atomics.load(doorbell, BELL_WAKE);
+    if (this.o.precision) {
+      const sleep = Math.min(maxS, deadline - PRECISION_SPIN_S - clock.now());
+      if (sleep > 0) Atomics.wait(doorbell, BELL_WAKE, seen, sleep * 1000);
+      if (deadline - clock.now() <= PRECISION_SPIN_S) {
+        while (clock.now() < deadline && Atomics.load(doorbell, BELL_WAKE) === seen) {
+          // spin: precision mode trades a little CPU for sub-10 µs ticks
         }
       }
+      return;
     }
-    this.tick();
-  };
+    const target = deadline - this.margin;
+    const sleep = Math.min(maxS, target - clock.now());
+    if (sleep <= 0) return;
+    const res = Atomics.wait(doorbell, BELL_WAKE, seen, sleep * 1000);
+    if (res === "timed-out" && sleep < maxS) {
+      const over = clock.now() - target;
+      if (over >= 0 && over < 0.002) this.overshoot += 0.05 * (over - this.overshoot);
+    }
+  }
 }

@@ -1,6 +1,13 @@
 import { z } from "zod";
 import { BlockConfigError, defineBlock, EMPTY_SHAPE } from "../../engine";
 
+/** 1st, 2nd, 3rd, 4th, …, 11th, 12th, 13th, …, 21st, 82nd. */
+export function ordinal(n: number): string {
+  const t = n % 100;
+  if (t >= 11 && t <= 13) return `${n}th`;
+  return `${n}${["th", "st", "nd", "rd"][n % 10] ?? "th"}`;
+}
+
 export const DecimatorTimer = defineBlock({
   type: "DecimatorTimer",
   category: "Timing",
@@ -34,13 +41,11 @@ export const DecimatorTimer = defineBlock({
     const effective = input.rate > 0 ? input.rate / factor : desired;
     if (input.rate > 0 && Math.abs(effective - desired) > 1e-9 * desired) {
       ctx.warn(
-        `${input.rate} Hz / ${desired} Hz is not a whole number; forwarding every ${factor}th tick gives ${effective.toPrecision(6)} Hz`,
+        `${input.rate} Hz / ${desired} Hz is not a whole number; forwarding every ${ordinal(factor)} tick gives ${effective.toPrecision(6)} Hz`,
       );
     }
     ctx.setDesiredRate(effective);
-    ctx.setText(
-      `every ${factor}${factor === 1 ? "st" : factor === 2 ? "nd" : factor === 3 ? "rd" : "th"} tick`,
-    );
+    ctx.setText(`every ${ordinal(factor)} tick`);
     const out = ctx.output(EMPTY_SHAPE);
     let count = 0;
     return {

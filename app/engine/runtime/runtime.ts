@@ -99,11 +99,15 @@ export interface Telemetry {
 
 export interface PlanBlock {
   name: string;
+  type: string;
   worker: string;
   desiredRate: number;
   isTimer: boolean;
   finite: boolean;
   outputs: { name: string; shape: Shape }[];
+  inputs: { block: string; port: string }[];
+  /** The block's declared input queue capacity (events), if any. */
+  queueCapacity?: number;
 }
 export interface Plan {
   blocks: PlanBlock[];
@@ -416,11 +420,14 @@ export class Runtime {
         const n = rt.byName.get(b.name) ?? planning.find((x) => x.name === b.name)!;
         return {
           name: b.name,
+          type: b.type,
           worker: b.worker,
           desiredRate: n.desiredRate,
           isTimer: b.def.timer === true,
           finite: n.finite,
           outputs: n.ports.map((p) => ({ name: p.name, shape: p.shape })),
+          inputs: b.inputs.map((i) => ({ block: i.block, port: i.port })),
+          ...(b.queue.capacity !== undefined ? { queueCapacity: b.queue.capacity } : {}),
         };
       }),
     };
@@ -744,6 +751,11 @@ export class Runtime {
 
   get pending(): number {
     return this.fifo.length;
+  }
+
+  /** True when a block on this worker is fed by I/O callbacks (see `BlockDefinition.eventLoop`). */
+  get needsEventLoop(): boolean {
+    return this.nodes.some((n) => n.def.eventLoop === true);
   }
 
   /** True when every finite source has finished (never true without finite sources). */

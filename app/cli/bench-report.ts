@@ -1,0 +1,767 @@
+/**
+ * `mosaic bench`, report side: result types, DESIGN.md §6 targets, MOSAIC's published figures
+ * (paper section V: Tables 5 and 6, Fig. 6 and 7) and the Markdown tables.
+ */
+
+export interface StatusShares {
+  /** % of the steady-state telemetry lines (20 Hz) in each status. */
+  ontime: number;
+  idle: number;
+  lagging: number;
+  stumbling: number;
+}
+
+export interface BlockRow {
+  name: string;
+  type: string;
+  desiredRate: number;
+  /** Number of ΔT values (consecutive output pairs) after the warm-up. */
+  n: number;
+  meanDt: number;
+  freq: number;
+  stdDt: number;
+  /** Mean compute time per `process` call after the warm-up, µs. */
+  computeMeanUs: number;
+  calls: number;
+  /** Events dropped on the edges into the block during the measured interval. */
+  dropsIn: number;
+  shares: StatusShares | null;
+}
+
+export interface TimerFigures {
+  name: string;
+  desiredRate: number;
+  /** Ticks fired and missed during the measured interval (after the warm-up). */
+  fired: number;
+  missed: number;
+  latenessP50Us: number;
+  latenessP99Us: number;
+  latenessMaxUs: number;
+}
+
+export interface CpuFigures {
+  /** Which reading the headline figures use. */
+  source: "schedstat" | "stat";
+  /** Steady-state 1-s samples, % of one core. */
+  samples: number;
+  medianPct: number;
+  p90Pct: number;
+  meanPct: number;
+  stdPct: number;
+  /** The same from /proc/<pid>/stat ticks (1 tick = 1/CLK_TCK s, i.e. 1 % in a 1-s sample). */
+  ticksMedianPct: number;
+  ticksMeanPct: number;
+  clkTck: number;
+  /** Steady-state CPU of each thread (schedstat; busiest first; threads under 0.05 % left out).
+   * `main` is the CLI's main thread; the others are named by tid (Node names them all "node"). */
+  threads: { thread: string; pct: number }[];
+  trace: { t: number; pct: number; ticksPct: number; rssMiB: number; steady: boolean }[];
+}
+
+export interface PipelineResult {
+  kind: "pipeline";
+  id: string;
+  title: string;
+  /** Key into PAPER for the paper's Tables 5/6, if MOSAIC reported this pipeline. */
+  paper?: "myo" | "delsys";
+  file: string;
+  args: string[];
+  ok: boolean;
+  error?: string;
+  warmupSeconds: number;
+  steadySeconds: number;
+  /** Seconds covered by the ΔT statistics (warm-up end → stop), from the summary. */
+  measuredSeconds: number;
+  cpu: CpuFigures | null;
+  /** CPU of a bare worker that only sleeps until each deadline at the same timer rate (% of one core). */
+  wakeFloorPct?: number;
+  /** Σ of the blocks' measured `process` time over the measured interval, % of one core. */
+  blocksComputePct: number;
+  memory: { peakRssMiB: number; steadyRssMedianMiB: number } | null;
+  blocks: BlockRow[];
+  timers: TimerFigures[];
+  /** Events dropped on all edges during the measured interval, and since start. */
+  drops: number;
+  dropsAllTime: number;
+  telemetryLines: number;
+  loadAvgBefore: number[];
+  loadAvgAfter: number[];
+  loadSeconds: number;
+  lingerSeconds: number;
+  killedAfterSummary: boolean;
+  warnings: string[];
+}
+
+export interface ReplayResult {
+  kind: "replay";
+  id: string;
+  title: string;
+  file: string;
+  args: string[];
+  ok: boolean;
+  error?: string;
+  channels: number;
+  rate: number;
+  recordingSeconds: number;
+  recordingBytes: number;
+  virtualSeconds: number;
+  /** The run's own wall time (host started → stopped), from the summary. */
+  wallSeconds: number;
+  /** Spawn → summary minus wallSeconds: process start, WASM, pipeline and recording load. */
+  loadSeconds: number;
+  channelSamplesPerSecond: number;
+  /** Frames (ticks) per wall second. */
+  framesPerSecond: number;
+  calibration?: { virtualSeconds: number; wallSeconds: number; channelSamplesPerSecond: number };
+  peakRssMiB: number;
+  loadAvgBefore: number[];
+  loadAvgAfter: number[];
+  lingerSeconds: number;
+  killedAfterSummary: boolean;
+}
+
+export type WorkloadResult = PipelineResult | ReplayResult;
+
+export interface TargetRow {
+  id: string;
+  workload: string;
+  metric: string;
+  paper: string;
+  target: string;
+  limit: number | null;
+  /** "max": the figure must not exceed limit; "min": it must reach it. */
+  sense: "max" | "min";
+  unit: string;
+  value: number | null;
+  display: string;
+  pass: boolean | null;
+  note: string;
+}
+
+// ---------------------------------------------------------------------------------------------
+// MOSAIC's published figures (paper section V), for the comparison columns.
+
+interface PaperBlock {
+  block: string;
+  rate: number;
+  meanDt: number;
+  freq: number;
+  stdDt: number;
+  /** Table 6: G, I, L, S in % (null = "-"). */
+  status: [number | null, number | null, number | null, number | null];
+}
+
+/** Keyed by our block names (the paper's row name is `block`). */
+export const PAPER: Record<"myo" | "delsys", Record<string, PaperBlock>> = {
+  myo: {
+    Timer: {
+      block: "Scheduled Timer",
+      rate: 200,
+      meanDt: 0.0050001,
+      freq: 199.9955,
+      stdDt: 0.0002417,
+      status: [100, null, null, null],
+    },
+    Myo: {
+      block: "Myo",
+      rate: 200,
+      meanDt: 0.0050001,
+      freq: 199.9978,
+      stdDt: 0.0002641,
+      status: [100, null, null, null],
+    },
+    Amplification: {
+      block: "Amplification",
+      rate: 200,
+      meanDt: 0.005,
+      freq: 199.9993,
+      stdDt: 0.0002837,
+      status: [100, null, null, null],
+    },
+    Rectification: {
+      block: "Rectification",
+      rate: 200,
+      meanDt: 0.005,
+      freq: 199.9993,
+      stdDt: 0.0003017,
+      status: [100, null, null, null],
+    },
+    LowPass: {
+      block: "Low Pass Filter",
+      rate: 200,
+      meanDt: 0.0049999,
+      freq: 200.0042,
+      stdDt: 0.0003385,
+      status: [100, null, null, null],
+    },
+    Resampler: {
+      block: "Resampler",
+      rate: 25,
+      meanDt: 0.0400009,
+      freq: 24.9994,
+      stdDt: 0.0002944,
+      status: [100, null, null, null],
+    },
+    Predictor: {
+      block: "Incremental Predictor",
+      rate: 25,
+      meanDt: 0.0400005,
+      freq: 24.9997,
+      stdDt: 0.0004624,
+      status: [100, null, null, null],
+    },
+    Sender: {
+      block: "UDP Sender",
+      rate: 25,
+      meanDt: 0.0399848,
+      freq: 25.0095,
+      stdDt: 0.0009457,
+      status: [100, null, null, null],
+    },
+  },
+  delsys: {
+    Delsys: {
+      block: "Delsys Trigno Avanti",
+      rate: 1926,
+      meanDt: 0.0005192,
+      freq: 1926.0572,
+      stdDt: 0.0003156,
+      status: [99.175, 0.022, 0.802, null],
+    },
+    Amplification: {
+      block: "Amplification",
+      rate: 1926,
+      meanDt: 0.0005192,
+      freq: 1926.0736,
+      stdDt: 0.0003523,
+      status: [98.8, 0.037, 1.163, null],
+    },
+    Rectification: {
+      block: "Rectification",
+      rate: 1926,
+      meanDt: 0.0005192,
+      freq: 1926.0744,
+      stdDt: 0.0003641,
+      status: [98.666, 0.041, 1.293, null],
+    },
+    LowPass: {
+      block: "Low Pass Filter",
+      rate: 1926,
+      meanDt: 0.0005192,
+      freq: 1926.1146,
+      stdDt: 0.000383,
+      status: [98.319, 0.046, 1.635, null],
+    },
+    Resampler: {
+      block: "Resampler",
+      rate: 25,
+      meanDt: 0.0399797,
+      freq: 25.0127,
+      stdDt: 0.0020564,
+      status: [100, null, null, null],
+    },
+    Predictor: {
+      block: "Incremental Predictor",
+      rate: 25,
+      meanDt: 0.0399795,
+      freq: 25.0128,
+      stdDt: 0.0022413,
+      status: [100, null, null, null],
+    },
+    Sender: {
+      block: "UDP Sender",
+      rate: 25,
+      meanDt: 0.0399674,
+      freq: 25.0204,
+      stdDt: 0.0025883,
+      status: [100, null, null, null],
+    },
+  },
+};
+
+/** The paper's CPU figures are % of an 8-core machine (Fig. 6); in cores: × 8 / 100. */
+export const PAPER_CPU = {
+  myo: { pct8: 12.01, sd8: 1.73, cores: (12.01 * 8) / 100 },
+  delsys: { pct8: 29.29, sd8: 2.19, cores: (29.29 * 8) / 100 },
+};
+
+// ---------------------------------------------------------------------------------------------
+// Number formatting
+
+export function fmt(x: number | null | undefined, digits: number): string {
+  return x === null || x === undefined || !Number.isFinite(x) ? "-" : x.toFixed(digits);
+}
+
+function fmtPct(x: number): string {
+  return !Number.isFinite(x) ? "-" : x < 10 ? `${x.toFixed(2)} %` : `${x.toFixed(1)} %`;
+}
+
+function fmtShare(x: number | null | undefined): string {
+  return x === null || x === undefined || !(x > 0) ? "-" : x.toFixed(3);
+}
+
+function fmtRate(x: number): string {
+  if (!Number.isFinite(x)) return "-";
+  return Number.isInteger(x) ? String(x) : x.toFixed(4);
+}
+
+function fmtMs(x: number): string {
+  return !Number.isFinite(x) ? "-" : `${(x * 1000).toFixed(3)} ms`;
+}
+
+export function fmtRateSI(x: number): string {
+  if (!Number.isFinite(x)) return "-";
+  if (x >= 1e6) return `${(x / 1e6).toFixed(2)} M`;
+  if (x >= 1e3) return `${(x / 1e3).toFixed(1)} k`;
+  return x.toFixed(0);
+}
+
+function table(head: string[], rows: string[][]): string[] {
+  const line = (cells: string[]) => `| ${cells.join(" | ")} |`;
+  return [line(head), line(head.map(() => "---")), ...rows.map(line)];
+}
+
+export function load(l: number[]): string {
+  return l.length ? l.map((x) => x.toFixed(2)).join(" / ") : "-";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Targets (DESIGN.md §6)
+
+function pipeline(results: WorkloadResult[], id: string): PipelineResult | undefined {
+  const r = results.find((w) => w.id === id);
+  return r && r.kind === "pipeline" ? r : undefined;
+}
+function replay(results: WorkloadResult[], id: string): ReplayResult | undefined {
+  const r = results.find((w) => w.id === id);
+  return r && r.kind === "replay" ? r : undefined;
+}
+
+function judged(
+  row: Omit<TargetRow, "pass" | "display" | "note"> & { note?: string },
+  display: (v: number) => string,
+  missingWhy: string | undefined,
+): TargetRow {
+  const v = row.value;
+  if (row.limit === null && v !== null && Number.isFinite(v)) {
+    // a figure reported for information, without a target
+    return { ...row, display: display(v), pass: null, note: row.note ?? "" };
+  }
+  if (v === null || !Number.isFinite(v) || row.limit === null) {
+    return {
+      ...row,
+      value: null,
+      display: "not measured",
+      pass: null,
+      note: missingWhy ?? row.note ?? "",
+    };
+  }
+  const pass = row.sense === "max" ? v <= row.limit : v >= row.limit;
+  return { ...row, display: display(v), pass, note: row.note ?? "" };
+}
+
+function why(r: WorkloadResult | undefined, id: string): string {
+  if (!r) return `workload '${id}' was not run (--only)`;
+  return r.ok ? "" : `workload '${id}' failed: ${r.error ?? "unknown error"}`;
+}
+
+export function targets(results: WorkloadResult[]): TargetRow[] {
+  const rows: TargetRow[] = [];
+  const cpuRow = (id: string, workload: string, paper: string, limit: number): TargetRow => {
+    const r = pipeline(results, id);
+    const c = r?.ok ? r.cpu : null;
+    return judged(
+      {
+        id: `cpu-${id}`,
+        workload,
+        metric: "CPU, steady-state median of 1-s samples (% of one core)",
+        paper,
+        target: `≤ ${limit} % of one core`,
+        limit,
+        sense: "max",
+        unit: "% of one core",
+        value: c ? c.medianPct : null,
+        note: c
+          ? `p90 ${fmtPct(c.p90Pct)}, mean ${fmtPct(c.meanPct)} ± ${fmtPct(c.stdPct)} (${c.samples} samples); /proc/stat ticks: median ${fmtPct(c.ticksMedianPct)}, mean ${fmtPct(c.ticksMeanPct)}` +
+            (r?.wakeFloorPct !== undefined
+              ? `; wake-up floor on this machine (a bare worker sleeping at the same rate, nothing else): ${fmtPct(r.wakeFloorPct)}`
+              : "")
+          : "",
+      },
+      fmtPct,
+      why(r, id),
+    );
+  };
+  rows.push(
+    cpuRow(
+      "myo",
+      "Myo pipeline, 8 ch @ 200 Hz",
+      `${PAPER_CPU.myo.pct8} % ± ${PAPER_CPU.myo.sd8} % of 8 cores ≈ ${PAPER_CPU.myo.cores.toFixed(2)} core (≈ ${(PAPER_CPU.myo.cores * 100).toFixed(0)} % of one core)`,
+      2,
+    ),
+  );
+  rows.push(
+    cpuRow(
+      "delsys",
+      "Delsys pipeline, 32 ch @ 1926 Hz",
+      `${PAPER_CPU.delsys.pct8} % ± ${PAPER_CPU.delsys.sd8} % of 8 cores ≈ ${PAPER_CPU.delsys.cores.toFixed(2)} cores (≈ ${(PAPER_CPU.delsys.cores * 100).toFixed(0)} % of one core)`,
+      5,
+    ),
+  );
+  rows.push(cpuRow("hdemg", "High-density EMG, 256 ch @ 2048 Hz", "not reported", 10));
+  {
+    const r = pipeline(results, "delsys");
+    rows.push(
+      judged(
+        {
+          id: "rss-delsys",
+          workload: "Memory, headless `mosaic run` of the Delsys pipeline",
+          metric: "peak RSS (VmHWM), MiB",
+          paper:
+            "0.300 GiB ± 0.003 GiB (307 MiB) working set (Fig. 7; that figure is the 200 Hz Myo replay)",
+          target: "≤ 100 MiB RSS",
+          limit: 100,
+          sense: "max",
+          unit: "MiB",
+          value: r?.ok && r.memory ? r.memory.peakRssMiB : null,
+          note:
+            r?.ok && r.memory
+              ? `steady-state VmRSS median ${r.memory.steadyRssMedianMiB.toFixed(1)} MiB`
+              : "",
+        },
+        (v) => `${v.toFixed(1)} MiB`,
+        why(r, "delsys"),
+      ),
+    );
+  }
+  {
+    const r = pipeline(results, "timer");
+    const t = r?.ok ? r.timers[0] : undefined;
+    const paper = "not reported; ΔT std 0.24–0.38 ms for the acquisition blocks (Table 5)";
+    const note = t
+      ? `max ${t.latenessMaxUs.toFixed(0)} µs, ${t.missed} of ${t.fired + t.missed} ticks missed; timer ΔT std ${fmtMs(r!.blocks.find((b) => b.name === t.name)?.stdDt ?? NaN)}`
+      : "";
+    rows.push(
+      judged(
+        {
+          id: "timer-p50",
+          workload: "Timer at 2 kHz, default mode",
+          metric: "lateness (fire − deadline), median, µs",
+          paper,
+          target: "median ≤ 100 µs",
+          limit: 100,
+          sense: "max",
+          unit: "µs",
+          value: t ? t.latenessP50Us : null,
+          note,
+        },
+        (v) => `${v.toFixed(0)} µs`,
+        why(r, "timer"),
+      ),
+    );
+    rows.push(
+      judged(
+        {
+          id: "timer-p99",
+          workload: "Timer at 2 kHz, default mode",
+          metric: "lateness (fire − deadline), p99, µs",
+          paper,
+          target: "p99 ≤ 200 µs",
+          limit: 200,
+          sense: "max",
+          unit: "µs",
+          value: t ? t.latenessP99Us : null,
+          note,
+        },
+        (v) => `${v.toFixed(0)} µs`,
+        why(r, "timer"),
+      ),
+    );
+  }
+  {
+    const r = pipeline(results, "timer-precision");
+    const t = r?.ok ? r.timers[0] : undefined;
+    rows.push(
+      judged(
+        {
+          id: "timer-precision",
+          workload: "Timer at 2 kHz, `--precision` (spin the last ~0.3 ms)",
+          metric: "lateness median / p99, µs; CPU median",
+          paper: "not available in MOSAIC",
+          target: "none (information)",
+          limit: null,
+          sense: "max",
+          unit: "µs",
+          value: t ? t.latenessP99Us : null,
+          note: t
+            ? `max ${t.latenessMaxUs.toFixed(0)} µs, ${t.missed} of ${t.fired + t.missed} ticks missed; CPU median ${fmtPct(r!.cpu?.medianPct ?? NaN)} of one core`
+            : "",
+        },
+        (v) => `${t!.latenessP50Us.toFixed(0)} µs / ${v.toFixed(0)} µs`,
+        why(r, "timer-precision"),
+      ),
+    );
+  }
+  rows.push({
+    id: "latency-udp",
+    workload: "Sensor frame in → UDP datagram out, same worker",
+    metric: "p99 latency",
+    paper: "not reported",
+    target: "p99 ≤ 1 ms",
+    limit: 1,
+    sense: "max",
+    unit: "ms",
+    value: null,
+    display: "not measured",
+    pass: null,
+    note:
+      "needs the UDP input/output blocks (a later issue): the measurement sends datagrams into a " +
+      "UDP source on loopback and timestamps the datagrams the UDP sender emits",
+  });
+  for (const [id, label] of [
+    ["replay-32", "Virtual-clock replay, 5-block DSP chain, 32 ch @ 1926 Hz"],
+    ["replay-256", "Virtual-clock replay, 5-block DSP chain, 256 ch @ 2048 Hz"],
+  ] as const) {
+    const r = replay(results, id);
+    rows.push(
+      judged(
+        {
+          id,
+          workload: label,
+          metric: "channel-samples per wall second",
+          paper: "not possible (no virtual clock)",
+          target: "≥ 20 M channel-samples/s",
+          limit: 20e6,
+          sense: "min",
+          unit: "channel-samples/s",
+          value: r?.ok ? r.channelSamplesPerSecond : null,
+          note: r?.ok
+            ? `${r.virtualSeconds.toFixed(0)} virtual s in ${r.wallSeconds.toFixed(2)} s wall (${fmtRateSI(r.framesPerSecond)} frames/s); load ${r.loadSeconds.toFixed(2)} s not included`
+            : "",
+        },
+        (v) => `${fmtRateSI(v)} ch-samples/s`,
+        why(r, id),
+      ),
+    );
+  }
+  return rows;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Markdown
+
+export function targetsTable(rows: TargetRow[]): string[] {
+  return table(
+    ["workload", "metric", "MOSAIC (paper)", "target", "measured", "result", "notes"],
+    rows.map((t) => [
+      t.workload,
+      t.metric,
+      t.paper,
+      t.target,
+      t.display,
+      t.pass === null
+        ? t.value === null
+          ? "not measured"
+          : "info"
+        : t.pass
+          ? "met"
+          : "**MISSED**",
+      t.note,
+    ]),
+  );
+}
+
+export function pipelineMarkdown(r: PipelineResult, heading = "###"): string[] {
+  const out: string[] = [`${heading} ${r.title}`, ""];
+  out.push(`\`mosaic ${r.args.join(" ")}\``, "");
+  if (!r.ok) {
+    out.push(`**Failed:** ${r.error ?? "unknown error"}`, "");
+    return out;
+  }
+  const paper = r.paper ? PAPER[r.paper] : undefined;
+  const c = r.cpu;
+  const m = r.memory;
+  out.push(
+    `Warm-up ${r.warmupSeconds} s excluded; steady state ${r.steadySeconds} s of CPU/RSS samples ` +
+      `and ${r.telemetryLines} telemetry lines (20 Hz); ΔT statistics over ${r.measuredSeconds.toFixed(1)} s. ` +
+      `Load average before ${load(r.loadAvgBefore)}, after ${load(r.loadAvgAfter)} (2 shared cores).`,
+    "",
+  );
+  const res: string[] = [];
+  if (c) {
+    res.push(
+      `CPU (% of one core, ${c.source === "schedstat" ? "per-thread schedstat" : `/proc/stat at ${c.clkTck} ticks/s`}): ` +
+        `median ${fmtPct(c.medianPct)}, p90 ${fmtPct(c.p90Pct)}, mean ${fmtPct(c.meanPct)} ± ${fmtPct(c.stdPct)} ` +
+        `over ${c.samples} 1-s samples (from /proc/<pid>/stat ticks: median ${fmtPct(c.ticksMedianPct)}, mean ${fmtPct(c.ticksMeanPct)})`,
+    );
+    if (Number.isFinite(r.blocksComputePct)) {
+      res.push(
+        `Blocks' own compute (Σ of measured \`process\` time): ${fmtPct(r.blocksComputePct)} of one core; ` +
+          "the rest of the process CPU is runtime and host work (timer wake-ups, delivery, status, " +
+          "telemetry, JSON output, GC)",
+      );
+    }
+    if (r.wakeFloorPct !== undefined) {
+      res.push(
+        `Wake-up floor: a bare Node worker that only sleeps in Atomics.wait until each deadline at the ` +
+          `same rate (no engine, no blocks) uses ${fmtPct(r.wakeFloorPct)} of one core on this machine`,
+      );
+    }
+    if (c.threads.length) {
+      res.push(
+        `CPU by thread (steady-state mean): ${c.threads.map((t) => `${t.thread} ${fmtPct(t.pct)}`).join(", ")}`,
+      );
+    }
+  }
+  if (m) {
+    res.push(
+      `Memory: peak RSS (VmHWM) ${m.peakRssMiB.toFixed(1)} MiB, steady-state VmRSS median ${m.steadyRssMedianMiB.toFixed(1)} MiB`,
+    );
+  }
+  for (const t of r.timers) {
+    res.push(
+      `Timer ${t.name} (${t.desiredRate} Hz): ${t.fired} ticks fired, ${t.missed} missed after the warm-up; ` +
+        `lateness median ${t.latenessP50Us.toFixed(0)} µs, p99 ${t.latenessP99Us.toFixed(0)} µs, max ${t.latenessMaxUs.toFixed(0)} µs`,
+    );
+  }
+  res.push(
+    `Drops on edges: ${r.drops} after the warm-up (${r.dropsAllTime} in all); start-up (process start to ` +
+      `pipeline running) ${r.loadSeconds.toFixed(2)} s`,
+  );
+  if (r.warnings.length) res.push(`Warnings: ${r.warnings.join("; ")}`);
+  for (const l of res) out.push(`- ${l}`);
+  out.push("");
+
+  out.push(
+    "Table 5 — timing consistency (ΔT between consecutive outputs, emission clock, after the warm-up)",
+    "",
+  );
+  const head5 = [
+    "Block",
+    "Type",
+    "Rate (Hz)",
+    "Mean ΔT (s)",
+    "Freq. (Hz)",
+    "Std ΔT (s)",
+    "n",
+    "µs/call",
+  ];
+  if (paper) head5.push("MOSAIC: block", "Freq. (Hz)", "Std ΔT (s)");
+  out.push(
+    ...table(
+      head5,
+      r.blocks.map((b) => {
+        const row = [
+          b.name,
+          b.type,
+          fmtRate(b.desiredRate),
+          b.n > 0 ? fmt(b.meanDt, 7) : "-",
+          b.n > 0 ? fmt(b.freq, 4) : "-",
+          b.n > 1 ? fmt(b.stdDt, 7) : "-",
+          String(b.n),
+          fmt(b.computeMeanUs, 2),
+        ];
+        if (paper) {
+          const p = paper[b.name];
+          row.push(p ? p.block : "-", p ? fmt(p.freq, 4) : "-", p ? fmt(p.stdDt, 7) : "-");
+        }
+        return row;
+      }),
+    ),
+    "",
+  );
+  out.push(
+    "Table 6 — share of the steady state in each status (% of telemetry lines): G on time, I idle, L lagging, S stumbling",
+    "",
+  );
+  const head6 = ["Block", "G (%)", "I (%)", "L (%)", "S (%)", "drops"];
+  if (paper) head6.push("MOSAIC G / I / L / S (%)");
+  out.push(
+    ...table(
+      head6,
+      r.blocks.map((b) => {
+        const s = b.shares;
+        const row = [
+          b.name,
+          fmtShare(s?.ontime),
+          fmtShare(s?.idle),
+          fmtShare(s?.lagging),
+          fmtShare(s?.stumbling),
+          String(b.dropsIn),
+        ];
+        if (paper) {
+          const p = paper[b.name];
+          row.push(p ? p.status.map((x) => fmtShare(x)).join(" / ") : "-");
+        }
+        return row;
+      }),
+    ),
+    "",
+  );
+  const notes: string[] = [];
+  for (const b of r.blocks) {
+    if (b.desiredRate > 0 && b.freq > 1.5 * b.desiredRate) {
+      notes.push(
+        `${b.name} reads ${(b.freq / b.desiredRate).toFixed(1)}× its desired rate: the runtime counts ` +
+          "more outputs than ticks (e.g. one per output port).",
+      );
+    }
+    if (b.type === "Sink" && (b.n === 0 || (b.shares?.idle ?? 0) > 50)) {
+      notes.push(
+        `${b.name} is a Sink (placeholder for the UDP sender): without outputs its ΔT and status ` +
+          "come from what it consumes; here it has no ΔT or reads mostly idle.",
+      );
+    }
+  }
+  for (const n of notes) out.push(`Note: ${n}`, "");
+  return out;
+}
+
+export function replayMarkdown(rs: ReplayResult[], heading = "###"): string[] {
+  const out: string[] = [`${heading} Virtual-clock replay throughput (5-block DSP chain)`, ""];
+  out.push(
+    "FilePlayer (Loop) on a ScheduledTimer → Amplification → Rectification → LowPass → Resampler " +
+      "(DecimatorTimer 25 Hz), `--clock virtual`. Throughput = channels × rate × virtual seconds / " +
+      "the run's wall seconds (host start → stop; process start and file load reported apart).",
+    "",
+  );
+  out.push(
+    ...table(
+      [
+        "recording",
+        "virtual s",
+        "wall s",
+        "channel-samples/s",
+        "frames/s",
+        "start-up + load s",
+        "peak RSS (MiB)",
+        "load avg before / after",
+      ],
+      rs.map((r) =>
+        r.ok
+          ? [
+              `${r.channels} ch @ ${r.rate} Hz (${r.recordingSeconds} s, ${(r.recordingBytes / 2 ** 20).toFixed(1)} MiB CSV)`,
+              r.virtualSeconds.toFixed(0),
+              r.wallSeconds.toFixed(2),
+              fmtRateSI(r.channelSamplesPerSecond),
+              fmtRateSI(r.framesPerSecond),
+              r.loadSeconds.toFixed(2),
+              fmt(r.peakRssMiB, 1),
+              `${load(r.loadAvgBefore)} → ${load(r.loadAvgAfter)}`,
+            ]
+          : [
+              `${r.channels} ch @ ${r.rate} Hz`,
+              "-",
+              "-",
+              `failed: ${r.error ?? "?"}`,
+              "-",
+              "-",
+              "-",
+              "-",
+            ],
+      ),
+    ),
+    "",
+  );
+  return out;
+}
