@@ -41,7 +41,15 @@ export UV_PYTHON_DOWNLOADS=never
 UV_VERSION=$(cat tests/reference/UV_VERSION)
 if ! python3 -m uv --version 2>/dev/null | grep -q " ${UV_VERSION}"; then
   say "installing uv ${UV_VERSION}"
-  python3 -m pip install --quiet --user --disable-pip-version-check "uv==${UV_VERSION}"
+  pip_install() { python3 -m pip install --quiet --user --disable-pip-version-check "$@" "uv==${UV_VERSION}"; }
+  if ! python3 -m pip --version >/dev/null 2>&1; then
+    # Debian's own python3 comes without pip.
+    SUDO=""
+    [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+    $SUDO apt-get install -y -qq --no-install-recommends python3-pip >/dev/null
+  fi
+  # A Debian-managed python3 refuses user installs unless told that uv may live beside it (PEP 668).
+  pip_install 2>/dev/null || pip_install --break-system-packages
 fi
 python3 -m uv sync --quiet --project tests/reference --python python3.11 --frozen
 

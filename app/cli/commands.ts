@@ -183,6 +183,12 @@ async function cmdRun(args: string[]): Promise<number> {
     err(`${file}: invalid pipeline, not started`);
     return 2;
   }
+  if (mode === "virtual" && duration === undefined && !host.plan?.blocks.some((b) => b.finite)) {
+    err(
+      "note: under the virtual clock without --duration and without a finite source (a FilePlayer " +
+        "without Loop), the run goes on until Ctrl-C",
+    );
+  }
   const onSig = (): void => resolveDone("interrupted");
   process.once("SIGINT", onSig);
   process.once("SIGTERM", onSig);
