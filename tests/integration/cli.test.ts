@@ -69,6 +69,32 @@ describe("mosaic run", () => {
     expect(tel.blocks.length).toBe(9);
   });
 
+  test("a recording plays in its original timing in real time", () => {
+    const dir = tempDir();
+    const r = runCli(
+      [
+        "run",
+        "pipelines/examples/replay-envelope.yaml",
+        "--duration",
+        "2",
+        "--json",
+        "--log-dir",
+        dir,
+      ],
+      { timeoutMs: 30_000 },
+    );
+    expect(r.code).toBe(0);
+    const lines = jsonLines(r.stdout);
+    expect(lines.filter((l) => l.type === "telemetry").length).toBeGreaterThan(25);
+    const summary = lines.find((l) => l.type === "summary") as unknown as {
+      blocks: { name: string; events: number; status: string }[];
+    };
+    const rec = summary.blocks.find((b) => b.name === "Recording")!;
+    // 1000 rows per second of the real recording, from the pipeline's start.
+    expect(rec.events).toBeGreaterThan(1500);
+    expect(rec.events).toBeLessThan(2100);
+  });
+
   test("Ctrl-C stops cleanly and flushes the logs", async () => {
     const dir = tempDir();
     const f = join(dir, "log.yaml");

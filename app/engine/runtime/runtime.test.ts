@@ -271,6 +271,20 @@ describe("scheduler", () => {
     expect(e.lateness!.quantile(1)).toBe(5000);
   });
 
+  test("an entry fired slightly early is stamped with its deadline; re-arming in the past cannot hang", () => {
+    const s = new Scheduler(false);
+    s.earlyTolerance = 0.0001;
+    const stamps: number[] = [];
+    const e = s.add("once", 0, (t) => stamps.push(t));
+    s.once(e, 10.00005);
+    s.fireDue(10, (x, t) => x.cb(t));
+    expect(stamps).toEqual([10.00005]);
+    // A callback that always asks to run again at a time already due must not loop forever.
+    const loop = s.add("loop", 0, () => s.once(loop, 5));
+    s.once(loop, 5);
+    expect(s.fireDue(10, (x, t) => x.cb(t))).toBe(100_000);
+  });
+
   test("deadlines are base + k/rate (no drift) and fire in deadline order", () => {
     const s = new Scheduler(true);
     const order: string[] = [];

@@ -6,6 +6,8 @@
  */
 
 const HIST_MIN_US = -1000;
+/** A callback that keeps re-arming itself in the past cannot hang the worker: the loop yields. */
+const MAX_FIRES_PER_CALL = 100_000;
 const HIST_MAX_US = 20000;
 
 export class LatenessHistogram {
@@ -155,7 +157,10 @@ export class Scheduler {
       }
       due.fired++;
       count++;
-      fire(due, this.virtual ? deadline : now);
+      // Woken slightly early (within earlyTolerance), an entry is still stamped no earlier than
+      // its deadline: a callback that re-arms itself "at the next due time" then moves on.
+      fire(due, this.virtual ? deadline : Math.max(now, deadline));
+      if (count >= MAX_FIRES_PER_CALL) return count;
     }
   }
 }
