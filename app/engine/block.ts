@@ -56,6 +56,11 @@ export interface InputInfo {
 export interface Resources {
   resolve(path: string): string;
   readText(path: string): Promise<string>;
+  /**
+   * Writes a whole text file (creating its folder), e.g. a Buffer's dataset saved on request.
+   * Not for streams: use `ctx.openLog` for data that keeps coming.
+   */
+  writeText(path: string, text: string): Promise<void>;
 }
 
 export interface TimerHandle {
@@ -110,6 +115,11 @@ export interface BlockContext {
   /** Declares that this (finite) source is exhausted; a run ends when all finite sources are. */
   finish(): void;
   /**
+   * Subscribes or unsubscribes one of this block's own inputs at run time (MOSAIC's Buffer
+   * subscribes its `-Data` input while it records). Returns false when `index` is not an input.
+   */
+  setSubscribed(index: number, subscribed: boolean): boolean;
+  /**
    * Opens a log file in the same line format as `Path` (for the Logger block). `path` is a folder
    * or a file, like `Path`; `stream` names the file inside a folder (`<stream>.txt`). Returns null
    * when this runtime has no log sink (then say so in the block's status).
@@ -138,6 +148,8 @@ export interface BlockInstance {
 export interface BlockDefinition<S extends z.ZodType = z.ZodType> {
   /** Never changes once released: saved pipelines depend on it. */
   type: string;
+  /** Other names files may use for this type (MOSAIC's class names); loading one warns. */
+  aliases?: readonly string[];
   category: BlockCategory;
   /** One line. */
   summary: string;

@@ -38,6 +38,8 @@ function record(into: Recorded, f: Frame): void {
 export const noResources: Resources = {
   resolve: (p) => p,
   readText: (p) => Promise.reject(new Error(`no file access in this test (asked for '${p}')`)),
+  writeText: (p) =>
+    Promise.reject(new Error(`no file access in this test (asked to write '${p}')`)),
 };
 
 export interface VirtualRunOptions {
@@ -126,6 +128,8 @@ export class BlockHarness {
   text = "";
   warnings: string[] = [];
   readonly logs = new MemoryLogSink();
+  /** Subscription state the block asked for through `ctx.setSubscribed` (by input index). */
+  readonly subscribed: Record<number, boolean> = {};
   finished = false;
   clock: number;
   desiredRate: number;
@@ -235,6 +239,12 @@ export class BlockHarness {
       },
       finish() {
         h.finished = true;
+      },
+      setSubscribed(index: number, subscribed: boolean) {
+        const i = inputs[index];
+        if (!i) return false;
+        h.subscribed[index] = subscribed;
+        return true;
       },
       openLog(path: string, stream: string) {
         return h.logs.open(stream, "out", true, path);

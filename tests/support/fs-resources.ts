@@ -2,8 +2,8 @@
  * A `Resources` backed by node:fs for tests: paths resolve against a base folder (default: the
  * repository root), like the host resolves them against the pipeline file's folder.
  */
-import { readFile } from "node:fs/promises";
-import { isAbsolute, resolve } from "node:path";
+import { mkdir, readFile, writeFile } from "node:fs/promises";
+import { dirname, isAbsolute, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
 import type { Resources } from "../../app/engine";
 
@@ -14,6 +14,10 @@ export function fsResources(base: string = REPO_ROOT): Resources {
   return {
     resolve: res,
     readText: (p) => readFile(res(p), "utf8"),
+    writeText: async (p, text) => {
+      await mkdir(dirname(res(p)), { recursive: true });
+      await writeFile(res(p), text, "utf8");
+    },
   };
 }
 
@@ -21,6 +25,10 @@ export function fsResources(base: string = REPO_ROOT): Resources {
 export function memoryResources(files: Record<string, string>): Resources {
   return {
     resolve: (p) => p,
+    writeText: (p, text) => {
+      files[p] = text;
+      return Promise.resolve();
+    },
     readText: (p) => {
       const text = files[p];
       return text === undefined

@@ -5,7 +5,8 @@
  * no DOM, no console. Call `initDsp(bytes)` once per thread with the bytes of
  * `core-wasm/pkg/mosaic_core_bg.wasm` (or a compiled `WebAssembly.Module`), then create kernels.
  *
- * Buffers are row-major interleaved: event `e`, channel `c` is at index `e * channels + c`.
+ * Buffers are row-major interleaved: event `e`, channel `c` is at index `e * channels + c`; a
+ * window `[L, C]` (SlidingWindow's event) is `L` such rows, oldest first.
  * Arrays may be longer than `nEvents * channels` (frames have a capacity); only the first
  * `nEvents * channels` values are read or written.
  *
@@ -20,9 +21,14 @@ import {
   initSync,
   version,
   wasm_memory,
+  WasmAdaptiveFilter,
+  WasmArtifactRejector,
   WasmEmgSynth,
+  WasmFeatureKernel,
   WasmFilterBank,
   WasmFunctionKernel,
+  WasmSlidingWindow,
+  WasmWindowedFeatures,
 } from "../../../core-wasm/pkg/mosaic_core.js";
 
 /**
@@ -211,6 +217,11 @@ class Scratch {
       }
     }
     for (let i = 0; i < n; i++) h[at + i] = src[i] as number;
+  }
+
+  /** Value `i` of the buffer. */
+  get(i: number): number {
+    return f64()[this.at + i] as number;
   }
 
   /** Copies the first `n` values of the buffer into `dst[0..n)`. */
@@ -585,6 +596,590 @@ export class EmgSynth {
   }
 
   /** Frees the wasm memory of this generator. Further calls throw. */
+  dispose(): void {
+    this.inner?.free();
+    this.inner = null;
+  }
+}
+
+// ------------------------------------------------------------------------------------------------
+// Windows, features, adaptive filter, artifact rejection (issue 3)
+
+/** Time-domain EMG features (LibEMG abbreviations); see `FeatureKernel`. */
+export type FeatureName =
+  "MAV" | "RMS" | "WL" | "ZC" | "SSC" | "SSC_MOSAIC" | "VAR" | "IAV" | "DASDV" | "WAMP";
+
+export const FEATURE_NAMES: readonly FeatureName[] = [
+  "MAV",
+  "RMS",
+  "WL",
+  "ZC",
+  "SSC",
+  "SSC_MOSAIC",
+  "VAR",
+  "IAV",
+  "DASDV",
+  "WAMP",
+];
+
+/** A feature to compute; `threshold` is used by ZC, SSC, SSC_MOSAIC and WAMP (default 0). */
+export interface FeatureRequest {
+  feature: FeatureName;
+  threshold?: number;
+}
+
+function featureArgs(what: string, features: readonly FeatureRequest[]): [string, Float64Array] {
+  if (features.length === 0) throw new Error(`${what}: give at least one feature`);
+  for (const f of features) {
+    if (!FEATURE_NAMES.includes(f.feature)) {
+      throw new Error(
+        `${what}: unknown feature '${String(f.feature)}'; expected one of ${FEATURE_NAMES.join(", ")}`,
+      );
+    }
+  }
+  return [
+    features.map((f) => f.feature).join(","),
+    Float64Array.from(features, (f) => f.threshold ?? 0),
+  ];
+}
+
+function checkWhole(what: string, name: string, v: number, min: number): void {
+  if (!Number.isInteger(v) || v < min) {
+    throw new Error(`${what}: ${name} must be an integer of at least ${min}; got ${v}`);
+  }
+}
+
+/**
+ * Time-domain EMG features of windows `[rows, channels]` (Hudgins et al. 1993; Phinyomark,
+ * Phukpattaranont & Limsakul 2012), any subset computed in one pass over each window:
+ * MAV = mean|x|, RMS = √mean(x²), WL = Σ|Δx|, ZC = #{x_i·x_{i+1} < 0 and |Δx| ≥ T},
+ * SSC = #{(x_i − x_{i−1})(x_i − x_{i+1}) ≥ T}, SSC_MOSAIC (MOSAIC 1's rule: strict slope sign
+ * change, both |Δx| ≥ T), VAR = Σx²/(N−1), IAV = Σ|x|, DASDV = √(Σ(Δx)²/(N−1)),
+ * WAMP = #{|Δx| ≥ T}. The output of one window is `features × channels` values, feature-major.
+ */
+export class FeatureKernel {
+  readonly rows: number;
+  readonly channels: number;
+  /** Values per output event: features × channels. */
+  readonly width: number;
+  private inner: WasmFeatureKernel | null;
+  private capacity = 0;
+  private readonly input = new Scratch();
+  private readonly output = new Scratch();
+
+  constructor(features: readonly FeatureRequest[], rows: number, channels: number) {
+    requireReady("FeatureKernel");
+    checkChannels("FeatureKernel", channels);
+    checkWhole("FeatureKernel", "rows", rows, 2);
+    const [names, thresholds] = featureArgs("FeatureKernel", features);
+    try {
+      this.inner = new WasmFeatureKernel(names, thresholds, rows, channels, 4);
+    } catch (e) {
+      throw asError(e);
+    }
+    this.rows = rows;
+    this.channels = channels;
+    this.width = this.inner.output_width();
+    this.locate();
+  }
+
+  private locate(): void {
+    const k = this.inner as WasmFeatureKernel;
+    this.capacity = k.capacity();
+    this.input.place(k.input_ptr(), this.capacity * this.rows * this.channels);
+    this.output.place(k.output_ptr(), this.capacity * this.width);
+  }
+
+  /**
+   * Features of `nWindows` windows: `windows` holds `nWindows × rows × channels` values from index
+   * 0, `output` receives `nWindows × width`.
+   */
+  process(windows: Float64Array, output: Float64Array, nWindows: number): void {
+    const k = this.inner;
+    if (k === null) throw disposed("FeatureKernel");
+    const size = this.rows * this.channels;
+    if (!(Number.isInteger(nWindows) && nWindows >= 0)) {
+      throw new Error(
+        `FeatureKernel.process: nWindows must be a non-negative integer; got ${nWindows}`,
+      );
+    }
+    if (windows.length < nWindows * size || output.length < nWindows * this.width) {
+      throw new Error(
+        `FeatureKernel.process: ${nWindows} windows need ${nWindows * size} input and ` +
+          `${nWindows * this.width} output values; got ${windows.length} and ${output.length}`,
+      );
+    }
+    if (nWindows > this.capacity) {
+      k.ensure_capacity(grownCapacity(this.capacity, nWindows));
+      this.locate();
+    }
+    this.input.write(windows, nWindows * size);
+    if (!k.process(nWindows)) throw failed("FeatureKernel.process");
+    this.output.read(output, nWindows * this.width);
+  }
+
+  /** Does nothing (stateless); present for a uniform kernel interface. */
+  reset(): void {
+    if (this.inner === null) throw disposed("FeatureKernel");
+  }
+
+  dispose(): void {
+    this.inner?.free();
+    this.inner = null;
+  }
+}
+
+/** SlidingWindow's window functions (symmetric, as `scipy.signal.get_window(name, L, fftbins=False)`). */
+export type WindowFunctionName = "none" | "hann" | "hamming" | "blackman";
+
+/** Shared plumbing of the two windowing kernels: input, outputs per window, window ends. */
+interface WindowingInner {
+  input_ptr(): number;
+  output_ptr(): number;
+  ends_ptr(): number;
+  capacity(): number;
+  max_windows(n: number): number;
+  ensure_capacity(n: number): void;
+  process(n: number): number;
+  reset(): void;
+  free(): void;
+}
+
+abstract class Windowing {
+  readonly channels: number;
+  /** Values per produced event. */
+  readonly width: number;
+  protected inner: WindowingInner | null;
+  private capacity = 0;
+  private readonly input = new Scratch();
+  private readonly output = new Scratch();
+  private readonly ends = new Scratch();
+  private produced = 0;
+
+  protected constructor(
+    private readonly what: string,
+    inner: WindowingInner,
+    channels: number,
+    width: number,
+  ) {
+    this.inner = inner;
+    this.channels = channels;
+    this.width = width;
+    this.locate();
+  }
+
+  private locate(): void {
+    const k = this.inner as WindowingInner;
+    this.capacity = k.capacity();
+    const most = k.max_windows(this.capacity);
+    this.input.place(k.input_ptr(), this.capacity * this.channels);
+    this.output.place(k.output_ptr(), most * this.width);
+    this.ends.place(k.ends_ptr(), most);
+  }
+
+  /** The most events one call of `nEvents` input events can produce. */
+  maxWindows(nEvents: number): number {
+    const k = this.inner;
+    if (k === null) throw disposed(this.what);
+    return k.max_windows(nEvents);
+  }
+
+  /**
+   * Feeds `nEvents` events of `input` (`nEvents × channels` values from index 0) and returns the
+   * number of windows they completed; read them with `read` and `end` before the next call.
+   */
+  push(input: Float64Array, nEvents: number): number {
+    const k = this.inner;
+    if (k === null) throw disposed(this.what);
+    checkCall(`${this.what}.push`, nEvents, this.channels, input, null);
+    if (nEvents > this.capacity) {
+      k.ensure_capacity(grownCapacity(this.capacity, nEvents));
+      this.locate();
+    }
+    this.input.write(input, nEvents * this.channels);
+    const n = k.process(nEvents);
+    if (n < 0) throw failed(`${this.what}.push`);
+    this.produced = n;
+    return n;
+  }
+
+  /** Copies the `k` events produced by the last `push` into `output` (`k × width` values). */
+  read(output: Float64Array, k: number): void {
+    if (this.inner === null) throw disposed(this.what);
+    if (k > this.produced || output.length < k * this.width) {
+      throw new Error(
+        `${this.what}.read: asked for ${k} of ${this.produced} events into ${output.length} values`,
+      );
+    }
+    this.output.read(output, k * this.width);
+  }
+
+  /** Index (within the last `push`) of the newest input event of produced event `i`. */
+  end(i: number): number {
+    if (this.inner === null) throw disposed(this.what);
+    return this.ends.get(i);
+  }
+
+  /** Forgets every event. */
+  reset(): void {
+    const k = this.inner;
+    if (k === null) throw disposed(this.what);
+    k.reset();
+    this.produced = 0;
+  }
+
+  dispose(): void {
+    this.inner?.free();
+    this.inner = null;
+  }
+}
+
+/** Events a windowing kernel's buffers hold before the first call that needs more. */
+const WINDOWING_CAPACITY = 8;
+
+/**
+ * The SlidingWindow block's kernel: windows of `length` events (rows, oldest first) every `step`
+ * events once `length` have arrived, multiplied by the window function. A double-written ring
+ * keeps the latest `length` events contiguous: nothing moves per event.
+ */
+export class SlidingWindowKernel extends Windowing {
+  readonly length: number;
+  readonly step: number;
+
+  constructor(length: number, step: number, channels: number, fn: WindowFunctionName = "none") {
+    requireReady("SlidingWindowKernel");
+    checkChannels("SlidingWindowKernel", channels);
+    checkWhole("SlidingWindowKernel", "length", length, 1);
+    checkWhole("SlidingWindowKernel", "step", step, 1);
+    let inner: WasmSlidingWindow;
+    try {
+      inner = new WasmSlidingWindow(length, step, channels, fn, WINDOWING_CAPACITY);
+    } catch (e) {
+      throw asError(e);
+    }
+    super("SlidingWindowKernel", inner, channels, length * channels);
+    this.length = length;
+    this.step = step;
+  }
+}
+
+/**
+ * Features (as `FeatureKernel`) over a sliding window of a plain event stream: every `step`
+ * events, over the last `length` events, read straight from the ring (no copy).
+ */
+export class WindowedFeatureKernel extends Windowing {
+  readonly length: number;
+  readonly step: number;
+  private readonly features: readonly FeatureRequest["feature"][];
+
+  constructor(features: readonly FeatureRequest[], length: number, step: number, channels: number) {
+    requireReady("WindowedFeatureKernel");
+    checkChannels("WindowedFeatureKernel", channels);
+    checkWhole("WindowedFeatureKernel", "length", length, 2);
+    checkWhole("WindowedFeatureKernel", "step", step, 1);
+    const [names, thresholds] = featureArgs("WindowedFeatureKernel", features);
+    let inner: WasmWindowedFeatures;
+    try {
+      inner = new WasmWindowedFeatures(
+        names,
+        thresholds,
+        length,
+        step,
+        channels,
+        WINDOWING_CAPACITY,
+      );
+    } catch (e) {
+      throw asError(e);
+    }
+    super("WindowedFeatureKernel", inner, channels, inner.output_width());
+    this.length = length;
+    this.step = step;
+    this.features = features.map((f) => f.feature);
+  }
+
+  /**
+   * Replaces the thresholds; `features` must name the same features in the same order as at
+   * construction. The window history is kept.
+   */
+  setThresholds(features: readonly FeatureRequest[]): void {
+    const k = this.inner as WasmWindowedFeatures | null;
+    if (k === null) throw disposed("WindowedFeatureKernel");
+    if (
+      features.length !== this.features.length ||
+      features.some((f, i) => f.feature !== this.features[i])
+    ) {
+      throw new Error(
+        `WindowedFeatureKernel.setThresholds: expected the features ${this.features.join(", ")}`,
+      );
+    }
+    try {
+      k.set_thresholds(Float64Array.from(features, (f) => f.threshold ?? 0));
+    } catch (e) {
+      throw asError(e);
+    }
+  }
+}
+
+/** Where eq. 4 of the AdaptiveFilter takes |·|: `paper` LP(|ẋ|), `mosaic` |LP(ẋ)| (MOSAIC 1's code). */
+export type DerivativeOrderName = "paper" | "mosaic";
+
+export interface AdaptiveFilterOptions {
+  channels: number;
+  /** Nominal sampling rate (Hz): ΔT = 1 / sampleRate. */
+  sampleRate: number;
+  g1: number;
+  g2: number;
+  /** Cut-off (Hz) of the derivative's first-order low-pass. */
+  b1: number;
+  b2: number;
+  order?: DerivativeOrderName;
+}
+
+/**
+ * The AdaptiveFilter block's kernel (paper III-F, eqs. 2–4), per channel:
+ * F_c = exp(G2·|x| + G1·LP(|ẋ|, B1) + B2), α = 2πF_cΔT/(1 + 2πF_cΔT), y = αx + (1 − α)y[n−1].
+ */
+export class AdaptiveFilterKernel {
+  readonly channels: number;
+  private inner: WasmAdaptiveFilter | null;
+  private capacity = 0;
+  private readonly input = new Scratch();
+  private readonly output = new Scratch();
+  private readonly times = new Scratch();
+  private readonly cutoffs = new Scratch();
+
+  constructor(o: AdaptiveFilterOptions) {
+    requireReady("AdaptiveFilterKernel");
+    checkChannels("AdaptiveFilterKernel", o.channels);
+    try {
+      this.inner = new WasmAdaptiveFilter(
+        o.channels,
+        o.sampleRate,
+        o.g1,
+        o.g2,
+        o.b1,
+        o.b2,
+        o.order ?? "paper",
+        INITIAL_CAPACITY,
+      );
+    } catch (e) {
+      throw asError(e);
+    }
+    this.channels = o.channels;
+    this.locate();
+  }
+
+  private locate(): void {
+    const k = this.inner as WasmAdaptiveFilter;
+    this.capacity = k.capacity();
+    this.input.place(k.input_ptr(), this.capacity * this.channels);
+    this.output.place(k.output_ptr(), this.capacity * this.channels);
+    this.times.place(k.times_ptr(), this.capacity);
+    this.cutoffs.place(k.cutoff_ptr(), this.channels);
+  }
+
+  private prepare(what: string, nEvents: number, input: Float64Array, output: Float64Array) {
+    const k = this.inner;
+    if (k === null) throw disposed("AdaptiveFilterKernel");
+    checkCall(what, nEvents, this.channels, input, output);
+    if (nEvents > this.capacity) {
+      k.ensure_capacity(grownCapacity(this.capacity, nEvents));
+      this.locate();
+    }
+    this.input.write(input, nEvents * this.channels);
+    return k;
+  }
+
+  /** Filters `nEvents` events with the nominal ΔT. `output` may be `input`. */
+  process(input: Float64Array, output: Float64Array, nEvents: number): void {
+    const k = this.prepare("AdaptiveFilterKernel.process", nEvents, input, output);
+    if (!k.process(nEvents)) throw failed("AdaptiveFilterKernel.process");
+    this.output.read(output, nEvents * this.channels);
+  }
+
+  /**
+   * Filters with ΔT = t[n] − t[n−1] from `times` (seconds, one per event); the first event and
+   * repeated or decreasing timestamps use the nominal ΔT.
+   */
+  processTimed(
+    input: Float64Array,
+    times: Float64Array,
+    output: Float64Array,
+    nEvents: number,
+  ): void {
+    if (times.length < nEvents) {
+      throw new Error(
+        `AdaptiveFilterKernel.processTimed: ${nEvents} events need ${nEvents} timestamps; got ${times.length}`,
+      );
+    }
+    const k = this.prepare("AdaptiveFilterKernel.processTimed", nEvents, input, output);
+    this.times.write(times, nEvents);
+    if (!k.process_timed(nEvents)) throw failed("AdaptiveFilterKernel.processTimed");
+    this.output.read(output, nEvents * this.channels);
+  }
+
+  /** Changes G1, G2, B1 and B2 while running; the filter state is kept. */
+  setGains(g1: number, g2: number, b1: number, b2: number): void {
+    if (this.inner === null) throw disposed("AdaptiveFilterKernel");
+    try {
+      this.inner.set_gains(g1, g2, b1, b2);
+    } catch (e) {
+      throw asError(e);
+    }
+  }
+
+  /** The cut-off frequency (Hz) of channel `c` at the last sample (0 before any). */
+  cutoff(c: number): number {
+    if (this.inner === null) throw disposed("AdaptiveFilterKernel");
+    return this.cutoffs.get(c);
+  }
+
+  reset(): void {
+    if (this.inner === null) throw disposed("AdaptiveFilterKernel");
+    this.inner.reset();
+  }
+
+  dispose(): void {
+    this.inner?.free();
+    this.inner = null;
+  }
+}
+
+/** Reasons of the artifact kernel, in flag-bit order (bit `1 << i`). */
+export const ARTIFACT_REASONS = ["clipping", "flat", "jump", "drift", "nonfinite"] as const;
+export type ArtifactReasonName = (typeof ARTIFACT_REASONS)[number];
+
+export interface ArtifactOptions {
+  /** Samples per window (L ≥ 3). */
+  rows: number;
+  channels: number;
+  /** Fixed rails; undefined: auto (the running extreme of the channel). */
+  railLow?: number;
+  railHigh?: number;
+  clipTolerance: number;
+  clipFraction: number;
+  flatThreshold: number;
+  /** Infinity disables the jump test. */
+  jumpFactor: number;
+  /** Undefined disables the drift test. */
+  driftThreshold?: number;
+  /** Hard: rejected channels are zeroed in the clean windows; soft: windows pass unchanged. */
+  hard: boolean;
+}
+
+/**
+ * The ArtifactRejection block's kernel: per channel of every window, clipping, flat line,
+ * impulsive jump, drift and non-finite checks; clean windows, masks, reason flags and
+ * cumulative counters (see the Rust `ArtifactRejector` for the rules).
+ */
+export class ArtifactKernel {
+  readonly rows: number;
+  readonly channels: number;
+  private inner: WasmArtifactRejector | null;
+  private capacity = 0;
+  private readonly perChannel: number;
+  private readonly input = new Scratch();
+  private readonly clean = new Scratch();
+  private readonly masks = new Scratch();
+  private readonly flagsOut = new Scratch();
+  private readonly counts = new Scratch();
+
+  constructor(o: ArtifactOptions) {
+    requireReady("ArtifactKernel");
+    checkChannels("ArtifactKernel", o.channels);
+    checkWhole("ArtifactKernel", "rows", o.rows, 3);
+    try {
+      this.inner = new WasmArtifactRejector(
+        o.rows,
+        o.channels,
+        o.railLow ?? Number.NaN,
+        o.railHigh ?? Number.NaN,
+        o.clipTolerance,
+        o.clipFraction,
+        o.flatThreshold,
+        o.jumpFactor,
+        o.driftThreshold ?? Number.NaN,
+        o.hard,
+        1,
+      );
+    } catch (e) {
+      throw asError(e);
+    }
+    this.rows = o.rows;
+    this.channels = o.channels;
+    this.perChannel = this.inner.counters_per_channel();
+    this.locate();
+  }
+
+  private locate(): void {
+    const k = this.inner as WasmArtifactRejector;
+    this.capacity = k.capacity();
+    const size = this.rows * this.channels;
+    this.input.place(k.input_ptr(), this.capacity * size);
+    this.clean.place(k.clean_ptr(), this.capacity * size);
+    this.masks.place(k.mask_ptr(), this.capacity * this.channels);
+    this.flagsOut.place(k.flags_ptr(), this.capacity * this.channels);
+    this.counts.place(k.counters_ptr(), this.channels * this.perChannel);
+  }
+
+  /**
+   * Judges `nWindows` windows of `windows`; `clean` receives the clean windows, `mask` and `flags`
+   * (when given) `nWindows × channels` values (mask 1 = good; flags: bit i = ARTIFACT_REASONS[i]).
+   */
+  process(
+    windows: Float64Array,
+    nWindows: number,
+    clean: Float64Array,
+    mask: Float64Array,
+    flags: Float64Array | null = null,
+  ): void {
+    const k = this.inner;
+    if (k === null) throw disposed("ArtifactKernel");
+    const size = this.rows * this.channels;
+    checkCall("ArtifactKernel.process", nWindows, size, windows, clean);
+    if (
+      mask.length < nWindows * this.channels ||
+      (flags && flags.length < nWindows * this.channels)
+    ) {
+      throw new Error(
+        `ArtifactKernel.process: mask and flags need ${nWindows * this.channels} values each`,
+      );
+    }
+    if (nWindows > this.capacity) {
+      k.ensure_capacity(grownCapacity(this.capacity, nWindows));
+      this.locate();
+    }
+    this.input.write(windows, nWindows * size);
+    if (!k.process(nWindows)) throw failed("ArtifactKernel.process");
+    this.clean.read(clean, nWindows * size);
+    this.masks.read(mask, nWindows * this.channels);
+    if (flags) this.flagsOut.read(flags, nWindows * this.channels);
+  }
+
+  /** Windows judged since creation or the last `resetCounters`. */
+  windows(): number {
+    if (this.inner === null) throw disposed("ArtifactKernel");
+    return this.inner.windows();
+  }
+
+  /** Windows of channel `c` flagged for `reason` (index in ARTIFACT_REASONS), or rejected (index 5). */
+  counter(c: number, reason: number): number {
+    if (this.inner === null) throw disposed("ArtifactKernel");
+    return this.counts.get(c * this.perChannel + reason);
+  }
+
+  /** Zeroes the counters (learned auto rails are kept). */
+  resetCounters(): void {
+    if (this.inner === null) throw disposed("ArtifactKernel");
+    this.inner.reset_counters();
+  }
+
+  /** Counters and auto rails back to the initial state. */
+  reset(): void {
+    if (this.inner === null) throw disposed("ArtifactKernel");
+    this.inner.reset();
+  }
+
   dispose(): void {
     this.inner?.free();
     this.inner = null;

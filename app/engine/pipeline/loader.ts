@@ -175,6 +175,13 @@ export function objectKeys(schema: z.ZodType): string[] | undefined {
   return undefined;
 }
 
+/** JSON, but with infinities written as YAML's `.inf` (JSON.stringify would print null). */
+function paramsText(v: unknown): string {
+  return JSON.stringify(v, (_k, x: unknown) =>
+    x === Infinity ? ".inf" : x === -Infinity ? "-.inf" : x,
+  ).replace(/"(-?\.inf)"/g, "$1");
+}
+
 function pathText(path: readonly PropertyKey[]): string {
   let s = "";
   for (const p of path) {
@@ -354,7 +361,7 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
 
   const blocks: BlockSpec[] = [];
   const byName = new Map<string, BlockSpec>();
-  const typeNames = [...catalog.keys()];
+  const typeNames = [...catalog].filter(([n, d]) => n === d.type).map(([n]) => n);
 
   for (const pair of (root as YAMLMap).items) {
     const keyNode = pair.key as YamlNode | null;
@@ -429,6 +436,18 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
       } else {
         type = t;
         def = catalog.get(t);
+        if (def && def.type !== t) {
+          c.add(
+            "warning",
+            "type-alias",
+            c.pos(typeEntry.node as YamlNode),
+            `block '${name}': '${t}' is the old name of ${def.type}; loading it as ${def.type}`,
+            {
+              block: name,
+            },
+          );
+          type = def.type;
+        }
         if (!def) {
           const suggestion = closest(t, typeNames);
           c.error(
@@ -682,12 +701,10 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
               expected: `named params: a mapping with ${knownKeys && knownKeys.length ? knownKeys.join(", ") : "no keys"}`,
             },
           );
-        } else if (args.length === 0 || (args.length === 1 && args[0] === "")) {
-          raw = def.legacyParams([]);
-          legacy = true;
         } else {
+          const positional = args.length === 1 && args[0] === "" ? [] : args;
           try {
-            raw = def.legacyParams(args);
+            raw = def.legacyParams(positional);
             legacy = true;
           } catch (e) {
             rawOk = false;
@@ -736,7 +753,7 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
               "warning",
               "legacy-converted",
               paramsPos,
-              `block '${name}' (${type}): converted MOSAIC positional Params to ${JSON.stringify(raw)}`,
+              `block '${name}' (${type}): converted MOSAIC positional Params to ${paramsText(raw)}`,
               {
                 block: name,
               },

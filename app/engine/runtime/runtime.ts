@@ -578,6 +578,15 @@ export class Runtime {
       warn(message: string) {
         rt.warn(node, message);
       },
+      setSubscribed(index: number, subscribed: boolean): boolean {
+        const e = node.inEdges.find((x) => x.toIndex === index);
+        if (!e) return false;
+        if (e.subscribed !== subscribed) {
+          e.subscribed = subscribed;
+          if (!subscribed) rt.dropPending(e);
+        }
+        return true;
+      },
       openLog(path: string, stream: string, shape: Shape): LogChannel | null {
         if (!rt.logs) return null;
         const ch = rt.logs.open(stream, "out", true, path, shape);
@@ -635,6 +644,11 @@ export class Runtime {
     e.queue.push(f);
     e.pendingEvents += n;
     this.fifo.push(e);
+  }
+
+  /** Drops every frame still queued on `e` (an input that was just unsubscribed). */
+  dropPending(e: Edge): void {
+    this.cancelPending(e, e.queue.length);
   }
 
   private cancelPending(e: Edge, count: number): void {
