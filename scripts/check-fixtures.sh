@@ -14,6 +14,10 @@ PROJECT="$ROOT/tests/reference"
 GENERATORS=(
   "core-wasm/dsp/tests/fixtures/gen_lfilter.py:lfilter.json"
   "core-wasm/dsp/tests/fixtures/gen_function.py:function.json"
+  "core-wasm/dsp/tests/fixtures/gen_features.py:features.json"
+  "core-wasm/dsp/tests/fixtures/gen_window.py:window.json"
+  "core-wasm/dsp/tests/fixtures/gen_adaptive.py:adaptive.json"
+  "core-wasm/dsp/tests/fixtures/gen_artifact.py:artifact.json"
 )
 
 # uv as installed by scripts/setup.sh (pip --user: `python3 -m uv`), or on PATH.

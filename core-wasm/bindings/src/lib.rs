@@ -12,7 +12,11 @@
 //! The names of the exports are a contract with `app/engine/dsp/index.ts`.
 #![warn(missing_docs)]
 
-use mosaic_dsp::{EmgSynth, EmgSynthConfig, FilterBank, FunctionKernel, FunctionOp};
+use mosaic_dsp::{
+    AdaptiveFilter, AdaptiveFilterConfig, ArtifactConfig, ArtifactRejector, DerivativeOrder,
+    EmgSynth, EmgSynthConfig, Feature, FeatureKernel, FeatureSpec, FilterBank, FunctionKernel,
+    FunctionOp, SlidingWindow, WindowFunction, WindowedFeatures, ARTIFACT_COUNTERS,
+};
 use wasm_bindgen::prelude::*;
 
 /// The module's linear memory (a `WebAssembly.Memory`).
@@ -351,5 +355,603 @@ impl WasmEmgSynth {
     /// Returns to the initial state (targets are kept).
     pub fn reset(&mut self) {
         self.synth.reset();
+    }
+}
+
+/// Parses `MAV,WL,...` with one threshold per name (ignored by the features
+/// that take none).
+fn feature_specs(names: &str, thresholds: &[f64]) -> Result<Vec<FeatureSpec>, JsError> {
+    let names: Vec<&str> = names
+        .split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .collect();
+    if names.len() != thresholds.len() {
+        return Err(JsError::new(&format!(
+            "{} feature names but {} thresholds; give one threshold per feature",
+            names.len(),
+            thresholds.len()
+        )));
+    }
+    names
+        .iter()
+        .zip(thresholds)
+        .map(|(n, &t)| match Feature::parse(n) {
+            Some(f) => Ok(FeatureSpec::with_threshold(f, t)),
+            None => Err(JsError::new(&format!(
+                "unknown feature '{n}'; expected one of {}",
+                Feature::ALL.map(Feature::name).join(", ")
+            ))),
+        })
+        .collect()
+}
+
+/// Grows `v` to `len` values (moves it) when it is shorter.
+fn grow(v: &mut Vec<f64>, len: usize) {
+    if v.len() < len {
+        *v = vec![0.0; len];
+    }
+}
+
+/// [`FeatureKernel`]: windows `[rows, channels]` in, features out.
+#[wasm_bindgen]
+pub struct WasmFeatureKernel {
+    kernel: FeatureKernel,
+    capacity: usize,
+    input: Vec<f64>,
+    output: Vec<f64>,
+}
+
+#[wasm_bindgen]
+impl WasmFeatureKernel {
+    /// `features` is a comma-separated list of abbreviations (MAV, RMS, WL, ZC,
+    /// SSC, SSC_MOSAIC, VAR, IAV, DASDV, WAMP), `thresholds` one per feature.
+    #[wasm_bindgen(constructor)]
+    pub fn new(
+        features: &str,
+        thresholds: &[f64],
+        rows: usize,
+        channels: usize,
+        capacity_windows: usize,
+    ) -> Result<WasmFeatureKernel, JsError> {
+        let specs = feature_specs(features, thresholds)?;
+        let kernel = FeatureKernel::new(&specs, rows, channels).map_err(js_err)?;
+        let mut k = WasmFeatureKernel {
+            kernel,
+            capacity: 0,
+            input: Vec::new(),
+            output: Vec::new(),
+        };
+        k.ensure_capacity(capacity_windows.max(1));
+        Ok(k)
+    }
+
+    /// Byte address of the input buffer (`capacity × rows × channels`).
+    pub fn input_ptr(&self) -> usize {
+        self.input.as_ptr() as usize
+    }
+
+    /// Byte address of the output buffer (`capacity × output_width`).
+    pub fn output_ptr(&self) -> usize {
+        self.output.as_ptr() as usize
+    }
+
+    /// Capacity of the buffers, in windows.
+    pub fn capacity(&self) -> usize {
+        self.capacity
+    }
+
+    /// Values per output event (features × channels).
+    pub fn output_width(&self) -> usize {
+        self.kernel.output_width()
+    }
+
+    /// Grows the buffers to hold at least `windows` windows (moves them).
+    pub fn ensure_capacity(&mut self, windows: usize) {
+        if windows > self.capacity {
+            self.capacity = windows;
+            grow(
+                &mut self.input,
+                windows * self.kernel.rows() * self.kernel.channels(),
+            );
+            grow(&mut self.output, windows * self.kernel.output_width());
+        }
+    }
+
+    /// Computes the features of `n` windows. `false` when `n > capacity()`.
+    pub fn process(&mut self, n: usize) -> bool {
+        if n > self.capacity {
+            return false;
+        }
+        let size = self.kernel.rows() * self.kernel.channels();
+        let width = self.kernel.output_width();
+        self.kernel
+            .process(&self.input[..n * size], &mut self.output[..n * width])
+            .is_ok()
+    }
+}
+
+/// Input, window output and window-end buffers shared by the windowing wrappers.
+struct WindowScratch {
+    channels: usize,
+    /// Values per produced window.
+    width: usize,
+    capacity: usize,
+    input: Vec<f64>,
+    output: Vec<f64>,
+    /// Index of the newest event of each window, as f64 (read through the f64 heap view).
+    ends: Vec<f64>,
+    ends_usize: Vec<usize>,
+}
+
+impl WindowScratch {
+    fn new(channels: usize, width: usize) -> Self {
+        WindowScratch {
+            channels,
+            width,
+            capacity: 0,
+            input: Vec::new(),
+            output: Vec::new(),
+            ends: Vec::new(),
+            ends_usize: Vec::new(),
+        }
+    }
+
+    fn ensure(&mut self, events: usize, max_windows: usize) {
+        if events > self.capacity {
+            self.capacity = events;
+            grow(&mut self.input, events * self.channels);
+            grow(&mut self.output, max_windows * self.width);
+            if self.ends.len() < max_windows {
+                self.ends = vec![0.0; max_windows];
+                self.ends_usize = vec![0; max_windows];
+            }
+        }
+    }
+
+    /// Copies the first `k` window ends into the f64 buffer; returns `k` as i32.
+    fn finish(&mut self, k: usize) -> i32 {
+        for (d, &e) in self.ends.iter_mut().zip(&self.ends_usize[..k]) {
+            *d = e as f64;
+        }
+        k as i32
+    }
+}
+
+/// [`SlidingWindow`]: events in, windows out.
+#[wasm_bindgen]
+pub struct WasmSlidingWindow {
+    window: SlidingWindow,
+    scratch: WindowScratch,
+}
+
+#[wasm_bindgen]
+impl WasmSlidingWindow {
+    /// `function` is `none`, `hann`, `hamming` or `blackman`.
+    #[wasm_bindgen(constructor)]
+    pub fn new(
+        length: usize,
+        step: usize,
+        channels: usize,
+        function: &str,
+        capacity_events: usize,
+    ) -> Result<WasmSlidingWindow, JsError> {
+        let f = WindowFunction::parse(function).ok_or_else(|| {
+            JsError::new(&format!(
+                "unknown window function '{function}'; expected none, hann, hamming or blackman"
+            ))
+        })?;
+        let window = SlidingWindow::new(length, step, channels, f).map_err(js_err)?;
+        let width = window.window_size();
+        let mut w = WasmSlidingWindow {
+            window,
+            scratch: WindowScratch::new(channels, width),
+        };
+        w.ensure_capacity(capacity_events.max(1));
+        Ok(w)
+    }
+
+    /// Byte address of the input buffer (`capacity × channels`).
+    pub fn input_ptr(&self) -> usize {
+        self.scratch.input.as_ptr() as usize
+    }
+
+    /// Byte address of the window buffer (`max_windows(capacity) × length × channels`).
+    pub fn output_ptr(&self) -> usize {
+        self.scratch.output.as_ptr() as usize
+    }
+
+    /// Byte address of the window ends (f64 event indices, one per window).
+    pub fn ends_ptr(&self) -> usize {
+        self.scratch.ends.as_ptr() as usize
+    }
+
+    /// Capacity of the input buffer, in events.
+    pub fn capacity(&self) -> usize {
+        self.scratch.capacity
+    }
+
+    /// The most windows `n_events` events can produce.
+    pub fn max_windows(&self, n_events: usize) -> usize {
+        self.window.max_windows(n_events)
+    }
+
+    /// Grows the buffers to hold at least `events` input events (moves them).
+    pub fn ensure_capacity(&mut self, events: usize) {
+        let most = self.window.max_windows(events);
+        self.scratch.ensure(events, most);
+    }
+
+    /// Feeds `n_events` events; returns the number of windows written, or
+    /// −1 when `n_events > capacity()`.
+    pub fn process(&mut self, n_events: usize) -> i32 {
+        let s = &mut self.scratch;
+        if n_events > s.capacity {
+            return -1;
+        }
+        match self.window.process(
+            &s.input[..n_events * s.channels],
+            &mut s.output,
+            &mut s.ends_usize,
+        ) {
+            Ok(k) => s.finish(k),
+            Err(_) => -1,
+        }
+    }
+
+    /// Forgets every event.
+    pub fn reset(&mut self) {
+        self.window.reset();
+    }
+}
+
+/// [`WindowedFeatures`]: events in, features of every window out.
+#[wasm_bindgen]
+pub struct WasmWindowedFeatures {
+    kernel: WindowedFeatures,
+    scratch: WindowScratch,
+}
+
+#[wasm_bindgen]
+impl WasmWindowedFeatures {
+    /// Features (as [`WasmFeatureKernel::new`]) over windows of `length`
+    /// events every `step` events.
+    #[wasm_bindgen(constructor)]
+    pub fn new(
+        features: &str,
+        thresholds: &[f64],
+        length: usize,
+        step: usize,
+        channels: usize,
+        capacity_events: usize,
+    ) -> Result<WasmWindowedFeatures, JsError> {
+        let specs = feature_specs(features, thresholds)?;
+        let kernel = WindowedFeatures::new(&specs, length, step, channels).map_err(js_err)?;
+        let width = kernel.output_width();
+        let mut w = WasmWindowedFeatures {
+            kernel,
+            scratch: WindowScratch::new(channels, width),
+        };
+        w.ensure_capacity(capacity_events.max(1));
+        Ok(w)
+    }
+
+    /// Byte address of the input buffer.
+    pub fn input_ptr(&self) -> usize {
+        self.scratch.input.as_ptr() as usize
+    }
+
+    /// Byte address of the feature buffer.
+    pub fn output_ptr(&self) -> usize {
+        self.scratch.output.as_ptr() as usize
+    }
+
+    /// Byte address of the window ends.
+    pub fn ends_ptr(&self) -> usize {
+        self.scratch.ends.as_ptr() as usize
+    }
+
+    /// Capacity of the input buffer, in events.
+    pub fn capacity(&self) -> usize {
+        self.scratch.capacity
+    }
+
+    /// Values per output event (features × channels).
+    pub fn output_width(&self) -> usize {
+        self.kernel.output_width()
+    }
+
+    /// The most windows `n_events` events can produce.
+    pub fn max_windows(&self, n_events: usize) -> usize {
+        self.kernel.max_windows(n_events)
+    }
+
+    /// Grows the buffers to hold at least `events` input events (moves them).
+    pub fn ensure_capacity(&mut self, events: usize) {
+        let most = self.kernel.max_windows(events);
+        self.scratch.ensure(events, most);
+    }
+
+    /// Replaces the thresholds (one per feature, in order); the window
+    /// history is kept.
+    pub fn set_thresholds(&mut self, thresholds: &[f64]) -> Result<(), JsError> {
+        self.kernel.set_thresholds(thresholds).map_err(js_err)
+    }
+
+    /// Feeds `n_events` events; returns the number of windows, or −1 when
+    /// `n_events > capacity()`.
+    pub fn process(&mut self, n_events: usize) -> i32 {
+        let s = &mut self.scratch;
+        if n_events > s.capacity {
+            return -1;
+        }
+        match self.kernel.process(
+            &s.input[..n_events * s.channels],
+            &mut s.output,
+            &mut s.ends_usize,
+        ) {
+            Ok(k) => s.finish(k),
+            Err(_) => -1,
+        }
+    }
+
+    /// Forgets every event.
+    pub fn reset(&mut self) {
+        self.kernel.reset();
+    }
+}
+
+/// [`AdaptiveFilter`] with input, output and timestamp buffers.
+#[wasm_bindgen]
+pub struct WasmAdaptiveFilter {
+    filter: AdaptiveFilter,
+    scratch: Scratch,
+    times: Vec<f64>,
+}
+
+#[wasm_bindgen]
+impl WasmAdaptiveFilter {
+    /// See [`AdaptiveFilterConfig`]; `order` is `paper` (LP(|ẋ|)) or `mosaic` (|LP(ẋ)|).
+    #[wasm_bindgen(constructor)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        channels: usize,
+        sample_rate: f64,
+        g1: f64,
+        g2: f64,
+        b1: f64,
+        b2: f64,
+        order: &str,
+        capacity_events: usize,
+    ) -> Result<WasmAdaptiveFilter, JsError> {
+        let order = match order {
+            "paper" => DerivativeOrder::LowpassOfAbs,
+            "mosaic" => DerivativeOrder::AbsOfLowpass,
+            other => {
+                return Err(JsError::new(&format!(
+                    "unknown derivative order '{other}'; expected paper or mosaic"
+                )))
+            }
+        };
+        let cfg = AdaptiveFilterConfig {
+            channels,
+            sample_rate,
+            g1,
+            g2,
+            b1,
+            b2,
+            order,
+        };
+        let filter = AdaptiveFilter::new(cfg).map_err(js_err)?;
+        let scratch = Scratch::new(channels, capacity_events, true);
+        let times = vec![0.0; scratch.capacity];
+        Ok(WasmAdaptiveFilter {
+            filter,
+            scratch,
+            times,
+        })
+    }
+
+    /// Byte address of the input scratch buffer.
+    pub fn input_ptr(&self) -> usize {
+        self.scratch.input.as_ptr() as usize
+    }
+
+    /// Byte address of the output scratch buffer.
+    pub fn output_ptr(&self) -> usize {
+        self.scratch.output.as_ptr() as usize
+    }
+
+    /// Byte address of the timestamp buffer (one per event).
+    pub fn times_ptr(&self) -> usize {
+        self.times.as_ptr() as usize
+    }
+
+    /// Byte address of the cut-off of each channel at the last sample.
+    pub fn cutoff_ptr(&self) -> usize {
+        self.filter.cutoff().as_ptr() as usize
+    }
+
+    /// Capacity of the scratch buffers, in events.
+    pub fn capacity(&self) -> usize {
+        self.scratch.capacity
+    }
+
+    /// Grows the scratch buffers to hold at least `events` events (moves them).
+    pub fn ensure_capacity(&mut self, events: usize) {
+        self.scratch.ensure(events);
+        grow(&mut self.times, self.scratch.capacity);
+    }
+
+    /// Changes G1, G2, B1 and B2 (the state is kept).
+    pub fn set_gains(&mut self, g1: f64, g2: f64, b1: f64, b2: f64) -> Result<(), JsError> {
+        self.filter.set_gains(g1, g2, b1, b2).map_err(js_err)
+    }
+
+    /// Filters `n_events` events with the nominal step. `false` when
+    /// `n_events > capacity()`.
+    pub fn process(&mut self, n_events: usize) -> bool {
+        let Some(n) = self.scratch.len(n_events) else {
+            return false;
+        };
+        self.filter
+            .process(&self.scratch.input[..n], &mut self.scratch.output[..n])
+            .is_ok()
+    }
+
+    /// Filters `n_events` events with ΔT from the timestamp buffer.
+    pub fn process_timed(&mut self, n_events: usize) -> bool {
+        let Some(n) = self.scratch.len(n_events) else {
+            return false;
+        };
+        self.filter
+            .process_timed(
+                &self.scratch.input[..n],
+                &self.times[..n_events],
+                &mut self.scratch.output[..n],
+            )
+            .is_ok()
+    }
+
+    /// Back to the zero initial state.
+    pub fn reset(&mut self) {
+        self.filter.reset();
+    }
+}
+
+/// [`ArtifactRejector`] with window, clean, mask and flag buffers.
+#[wasm_bindgen]
+pub struct WasmArtifactRejector {
+    rejector: ArtifactRejector,
+    capacity: usize,
+    input: Vec<f64>,
+    clean: Vec<f64>,
+    mask: Vec<f64>,
+    flags: Vec<f64>,
+}
+
+#[wasm_bindgen]
+impl WasmArtifactRejector {
+    /// See [`ArtifactConfig`]; a NaN rail means auto, a NaN drift threshold
+    /// disables the drift test.
+    #[wasm_bindgen(constructor)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        rows: usize,
+        channels: usize,
+        rail_low: f64,
+        rail_high: f64,
+        clip_tolerance: f64,
+        clip_fraction: f64,
+        flat_threshold: f64,
+        jump_factor: f64,
+        drift_threshold: f64,
+        hard: bool,
+        capacity_windows: usize,
+    ) -> Result<WasmArtifactRejector, JsError> {
+        let some = |v: f64| (!v.is_nan()).then_some(v);
+        let cfg = ArtifactConfig {
+            rows,
+            channels,
+            rail_low: some(rail_low),
+            rail_high: some(rail_high),
+            clip_tolerance,
+            clip_fraction,
+            flat_threshold,
+            jump_factor,
+            drift_threshold: some(drift_threshold),
+            hard,
+        };
+        let rejector = ArtifactRejector::new(cfg).map_err(js_err)?;
+        let mut r = WasmArtifactRejector {
+            rejector,
+            capacity: 0,
+            input: Vec::new(),
+            clean: Vec::new(),
+            mask: Vec::new(),
+            flags: Vec::new(),
+        };
+        r.ensure_capacity(capacity_windows.max(1));
+        Ok(r)
+    }
+
+    /// Byte address of the window buffer (`capacity × rows × channels`).
+    pub fn input_ptr(&self) -> usize {
+        self.input.as_ptr() as usize
+    }
+
+    /// Byte address of the clean windows (same size as the input).
+    pub fn clean_ptr(&self) -> usize {
+        self.clean.as_ptr() as usize
+    }
+
+    /// Byte address of the masks (`capacity × channels`).
+    pub fn mask_ptr(&self) -> usize {
+        self.mask.as_ptr() as usize
+    }
+
+    /// Byte address of the reason flags (`capacity × channels`).
+    pub fn flags_ptr(&self) -> usize {
+        self.flags.as_ptr() as usize
+    }
+
+    /// Byte address of the counters (`channels × ARTIFACT_COUNTERS`).
+    pub fn counters_ptr(&self) -> usize {
+        self.rejector.counters().as_ptr() as usize
+    }
+
+    /// Counters per channel (one per reason, then the rejected total).
+    pub fn counters_per_channel(&self) -> usize {
+        ARTIFACT_COUNTERS
+    }
+
+    /// Windows judged since the counters were last reset.
+    pub fn windows(&self) -> f64 {
+        self.rejector.windows() as f64
+    }
+
+    /// Capacity of the buffers, in windows.
+    pub fn capacity(&self) -> usize {
+        self.capacity
+    }
+
+    /// Grows the buffers to hold at least `windows` windows (moves them).
+    pub fn ensure_capacity(&mut self, windows: usize) {
+        if windows > self.capacity {
+            self.capacity = windows;
+            let size = self.rejector.window_size();
+            let c = self.rejector.channels();
+            grow(&mut self.input, windows * size);
+            grow(&mut self.clean, windows * size);
+            grow(&mut self.mask, windows * c);
+            grow(&mut self.flags, windows * c);
+        }
+    }
+
+    /// Judges `n` windows. `false` when `n > capacity()`.
+    pub fn process(&mut self, n: usize) -> bool {
+        if n > self.capacity {
+            return false;
+        }
+        let size = self.rejector.window_size();
+        let c = self.rejector.channels();
+        self.rejector
+            .process(
+                &self.input[..n * size],
+                &mut self.clean[..n * size],
+                &mut self.mask[..n * c],
+                &mut self.flags[..n * c],
+            )
+            .is_ok()
+    }
+
+    /// Zeroes the counters (the auto rails are kept).
+    pub fn reset_counters(&mut self) {
+        self.rejector.reset_counters();
+    }
+
+    /// Back to the initial state (counters and auto rails).
+    pub fn reset(&mut self) {
+        self.rejector.reset();
     }
 }

@@ -89,6 +89,22 @@ pub enum DspError {
         /// Number of channels of the kernel.
         channels: usize,
     },
+    /// An output buffer does not have the length the input implies.
+    OutputLength {
+        /// Number of values given.
+        len: usize,
+        /// Number of values expected.
+        expected: usize,
+    },
+    /// An output buffer is too short for what the call produces.
+    TooShort {
+        /// Name of the buffer.
+        name: &'static str,
+        /// Number of values it holds.
+        len: usize,
+        /// Number of values the call needs.
+        needed: usize,
+    },
     /// Input and output buffers have different lengths.
     LengthMismatch {
         /// Number of values in the input.
@@ -160,6 +176,14 @@ impl fmt::Display for DspError {
             } => write!(
                 f,
                 "{name} has {len} values, which is not a whole number of events of {channels} channels; expected a multiple of {channels}"
+            ),
+            DspError::OutputLength { len, expected } => write!(
+                f,
+                "output has {len} values; expected {expected} for this input (events × values per output event)"
+            ),
+            DspError::TooShort { name, len, needed } => write!(
+                f,
+                "{name} has room for {len} values but this call produces {needed}; make it longer"
             ),
             DspError::LengthMismatch { input, output } => write!(
                 f,

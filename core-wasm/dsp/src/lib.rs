@@ -21,6 +21,14 @@
 //! * [`EmgSynth`] — a seeded multi-channel surface-EMG generator for the
 //!   *EmgSimulator* block.
 //! * [`design`] — second-order Butterworth designs (bilinear transform).
+//! * [`SlidingWindow`] — the MOSAIC *SlidingWindow* block: windows of `L`
+//!   events every `S` events, optionally tapered (Hann, Hamming, Blackman).
+//! * [`FeatureKernel`] — time-domain EMG features (MAV, RMS, WL, ZC, SSC,
+//!   VAR, IAV, DASDV, WAMP) of windows `[L, C]`, any subset in one pass;
+//!   [`WindowedFeatures`] computes them over a sliding window of a stream.
+//! * [`AdaptiveFilter`] — the MOSAIC *AdaptiveFilter* block (paper eqs. 2–4).
+//! * [`ArtifactRejector`] — the MOSAIC *ArtifactRejection* block: clipping,
+//!   flat line, jumps, drift per channel of a window.
 //!
 //! ```
 //! use mosaic_dsp::{FilterBank, FunctionKernel, FunctionOp};
@@ -37,17 +45,25 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+mod adaptive;
+mod artifact;
 pub mod design;
 mod error;
+mod features;
 mod filter;
 mod function;
 mod rng;
 mod synth;
+mod window;
 
+pub use adaptive::{AdaptiveFilter, AdaptiveFilterConfig, DerivativeOrder};
+pub use artifact::{ArtifactConfig, ArtifactReason, ArtifactRejector, ARTIFACT_COUNTERS};
 pub use error::DspError;
+pub use features::{Feature, FeatureKernel, FeatureSpec};
 pub use filter::FilterBank;
 pub use function::{FunctionKernel, FunctionOp};
 pub use synth::{EmgSynth, EmgSynthConfig};
+pub use window::{SlidingWindow, WindowFunction, WindowedFeatures};
 
 /// Checks that `len` values are a whole number of events of `channels` values.
 #[inline]
