@@ -244,13 +244,15 @@ const { schema } = generateDocs(BLOCKS);
 const check = (yamlText: string): string[] => validate(schema as Schema, parseYaml(yamlText));
 
 describe("pipeline JSON Schema", () => {
-  test("is a draft-07 schema whose Type enum lists every registered block", () => {
+  test("is a draft-07 schema whose Type enum lists every registered block and its aliases", () => {
     const s = schema as {
       $schema: string;
       definitions: { Block: { properties: { Type: { enum: string[] } } } };
     };
     expect(s.$schema).toBe("http://json-schema.org/draft-07/schema#");
-    expect(s.definitions.Block.properties.Type.enum).toEqual(BLOCKS.map((d) => d.type));
+    expect(s.definitions.Block.properties.Type.enum).toEqual(
+      BLOCKS.flatMap((d) => [d.type, ...(d.aliases ?? [])]),
+    );
   });
 
   test("every property of a block carries a description", () => {

@@ -123,7 +123,12 @@ function pipelineSchema(blocks: readonly AnyBlockDefinition[]): JsonSchema {
     if (def.timer || def.requiresRate) required.push("DesiredRate");
     if (def.inputs.min > 0) required.push("Inputs");
     branches.push({
-      if: { properties: { Type: { const: def.type } }, required: ["Type"] },
+      if: {
+        properties: {
+          Type: def.aliases?.length ? { enum: [def.type, ...def.aliases] } : { const: def.type },
+        },
+        required: ["Type"],
+      },
       then: {
         properties: { Params: params, ...(Object.keys(inputs).length ? { Inputs: inputs } : {}) },
         ...(required.length ? { required } : {}),
@@ -138,7 +143,7 @@ function pipelineSchema(blocks: readonly AnyBlockDefinition[]): JsonSchema {
       Type: {
         description: "The block type (see docs/blocks.md).",
         type: "string",
-        enum: blocks.map((d) => d.type),
+        enum: blocks.flatMap((d) => [d.type, ...(d.aliases ?? [])]),
       },
       DesiredRate: {
         description:
@@ -369,6 +374,11 @@ function paramsSection(def: AnyBlockDefinition): string[] {
 function blockSection(def: AnyBlockDefinition): string[] {
   const lines = [`### ${def.type}`, "", `**${def.summary.trim()}**`, "", def.help.trim(), ""];
   const facts = [`- **Type:** ${code(def.type)}`, `- **Category:** ${def.category}`];
+  if (def.aliases?.length) {
+    facts.push(
+      `- **Also loads as:** ${def.aliases.map(code).join(", ")} (older names, with a warning)`,
+    );
+  }
   facts.push(`- **Inputs:** ${inputsText(def)}`);
   facts.push(`- **Outputs:** ${outputsText(def)}`);
   if (def.timer)

@@ -3,14 +3,37 @@
  * Adding a block = one file in its category folder + one line here.
  */
 import { createCatalog, type AnyBlockDefinition } from "../engine";
+import { Dasdv } from "./features/dasdv";
+import { FeatureSet } from "./features/feature-set";
+import { IntegratedAbsoluteValue } from "./features/integrated-absolute-value";
+import { MeanAbsoluteValue } from "./features/mean-absolute-value";
+import { Rms } from "./features/rms";
+import { SlopeSignChanges } from "./features/slope-sign-changes";
+import { Variance } from "./features/variance";
+import { WaveformLength } from "./features/waveform-length";
+import { WillisonAmplitude } from "./features/willison-amplitude";
+import { ZeroCrossings } from "./features/zero-crossings";
+import { ArtifactRejection } from "./flow/artifact-rejection";
+import { BufferBlock } from "./flow/buffer";
+import { ChannelSelector } from "./flow/channel-selector";
 import { Joiner } from "./flow/joiner";
 import { Projector } from "./flow/projector";
 import { Resampler } from "./flow/resampler";
+import { Selector } from "./flow/selector";
+import { SlidingWindow } from "./flow/sliding-window";
 import { Splitter } from "./flow/splitter";
+import { Switch } from "./flow/switch";
+import { VectorialFunction } from "./flow/vectorial-function";
+import { Stimulus } from "./learning/stimulus";
+import { TAC } from "./learning/tac";
+import { Trigger } from "./learning/trigger";
 import { Logger } from "./recording/logger";
+import { AdaptiveFilter } from "./signal/adaptive-filter";
+import { ControlAlgorithm } from "./control/control-algorithm";
 import { Filter } from "./signal/filter";
 import { FunctionBlock } from "./signal/function";
 import { LinearMap } from "./signal/linear-map";
+import { Amplification, Rectification } from "./signal/presets";
 import { EmgSimulator } from "./sources/emg-simulator";
 import { FilePlayer } from "./sources/file-player";
 import { SinGenerator } from "./sources/sin-generator";
@@ -29,13 +52,40 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   FilePlayer,
   // Signal processing
   FunctionBlock,
+  Amplification,
+  Rectification,
   Filter,
   LinearMap,
+  AdaptiveFilter,
+  VectorialFunction,
+  // Features
+  MeanAbsoluteValue,
+  Rms,
+  WaveformLength,
+  ZeroCrossings,
+  SlopeSignChanges,
+  Variance,
+  IntegratedAbsoluteValue,
+  Dasdv,
+  WillisonAmplitude,
+  FeatureSet,
   // Flow control
+  SlidingWindow,
+  ArtifactRejection,
   Resampler,
   Joiner,
   Splitter,
   Projector,
+  BufferBlock,
+  ChannelSelector,
+  Selector,
+  Switch,
+  // Learning
+  Trigger,
+  Stimulus,
+  TAC,
+  // Control
+  ControlAlgorithm,
   // Recording
   Logger,
   // Testing

@@ -1,21 +1,37 @@
 /**
  * Contract tests over every block of the catalog (CONVENTIONS.md, after fundsp/biquad-rs): the
  * params validate and produce a JSON Schema with every param described; one frame of N events
- * gives the same output, bit for bit, as N frames of one event; after `reset` the output repeats.
- * A block missing from the table below fails the test, so every new block gets a setup here.
+ * gives the same output, bit for bit, as N frames of one event; after `reset` the output repeats;
+ * `dispose()` twice is harmless; and garbage params, loaded through the loader and the runtime
+ * like a pipeline file, are refused with a zod issue, a LegacyParamsError or a BlockConfigError —
+ * never a TypeError or RangeError from deep inside (nor one at run time, from an action or a live
+ * param). A block missing from the table below fails the test, so every new block gets a setup.
  */
+import fc from "fast-check";
+import { stringify } from "yaml";
 import { beforeAll, describe, expect, test } from "vitest";
 import { z } from "zod";
 import { BLOCKS } from "./catalog";
 import {
+  BlockConfigError,
+  createCatalog,
+  defineBlock,
   EMPTY_SHAPE,
+  errorMessage,
   Frame,
+  LegacyParamsError,
+  loadPipeline,
   matrixShape,
   objectKeys,
   outputNames,
+  Runtime,
+  runVirtual,
   shapeSize,
   vectorShape,
+  VirtualClock,
   type AnyBlockDefinition,
+  type BlockContext,
+  type BlockInstance,
   type Resources,
   type Shape,
 } from "../engine";
@@ -38,21 +54,50 @@ interface Setup {
   pattern?: number[];
   /** Number of events (default 40). */
   events?: number;
+  /** Values of event `i` on `port` (default: smooth varied numbers); `size` values. */
+  values?: (i: number, port: number, size: number) => number[];
   resources?: Resources;
   /** The block produces nothing observable (a sink). */
   silent?: boolean;
+  /**
+   * Params the garbage test leaves alone, because a huge value is a legitimate way to make the
+   * block take that long (with the reason); everything else is fuzzed.
+   */
+  fuzzKeep?: { keys: string[]; reason: string };
+  /**
+   * Known internal errors under garbage params (reported, in files this test does not own): a
+   * failure whose text matches is tolerated; the extremes test fails once none matches any more,
+   * so that the entry is removed when the block is fixed.
+   */
+  known?: { pattern: RegExp; reason: string }[];
 }
 
 const timer = (rate: number): InputSetup => ({ shape: EMPTY_SHAPE, rate, isTimer: true });
 const vec = (c: number, rate = 100): InputSetup => ({ shape: vectorShape(c), rate });
+const mat = (r: number, c: number, rate = 100): InputSetup => ({ shape: matrixShape(r, c), rate });
 
 const RECORDING = "time_s,a,b\n0,1,-1\n0.01,2,-2\n0.02,3.5,0.25\n0.03,-4,1e-3\n0.04,5,NaN\n";
 
-/** A valid setup for every block type of the catalog. */
-const SETUPS: Record<string, Setup> = {
+const smooth = (i: number, _port: number, size: number): number[] =>
+  Array.from({ length: size }, (_, k) => Math.sin(1.3 * i + 0.7 * k) * (1 + k));
+
+/** A feature block on window matrices, and on a plain stream that it windows itself. */
+const feature = (params: object = {}): Setup[] => [
+  { params, inputs: [mat(10, 3)] },
+  { params: { ...params, Window: 5, Hop: 2 }, inputs: [vec(2)] },
+];
+
+/**
+ * A valid setup for every block type of the catalog (several for blocks whose behaviour depends
+ * much on a param).
+ */
+const SETUPS: Record<string, Setup | Setup[]> = {
   ScheduledTimer: { params: {}, inputs: [] },
   DecimatorTimer: { params: {}, inputs: [timer(200)] },
-  SinGenerator: { params: { Components: 3, Frequency: 7 }, inputs: [timer(100)] },
+  SinGenerator: {
+    params: { Components: 3, Frequency: 7 },
+    inputs: [timer(100)],
+  },
   EmgSimulator: {
     params: {
       Channels: 6,
@@ -72,14 +117,72 @@ const SETUPS: Record<string, Setup> = {
   },
   Function: {
     params: { Operation: "multiply" },
-    inputs: [{ shape: matrixShape(2, 3) }, vec(3)],
+    inputs: [mat(2, 3), vec(3)],
     pattern: [0, 0, 1, 0, 1, 1, 0, 0, 0],
   },
+  Amplification: { params: { Gain: [1, -2, 0.5] }, inputs: [mat(2, 3)] },
+  Rectification: { params: {}, inputs: [vec(4)] },
   Filter: {
     params: { Numerator: [0.2, 0.3, 0.1], Denominator: [1, -0.6, 0.2] },
     inputs: [vec(4)],
   },
   LinearMap: { params: { Outputs: 3, Bias: [1, 2, 3] }, inputs: [vec(5)] },
+  AdaptiveFilter: [
+    { params: {}, inputs: [vec(3, 200)] },
+    { params: { UseTimestamps: true, Derivative: "mosaic", G1: 2 }, inputs: [vec(2, 200)] },
+  ],
+  MeanAbsoluteValue: feature(),
+  RMS: feature(),
+  WaveformLength: feature(),
+  ZeroCrossings: feature({ Threshold: 0.1 }),
+  SlopeSignChanges: feature({ Threshold: 0.05 }),
+  Variance: feature(),
+  IntegratedAbsoluteValue: feature(),
+  DASDV: feature(),
+  WillisonAmplitude: feature({ Threshold: 0.2 }),
+  FeatureSet: [
+    { params: {}, inputs: [mat(8, 2)] },
+    {
+      params: { Features: ["RMS", "WAMP", "SSC"], WAMPThreshold: 0.2, Window: 4, Hop: 3 },
+      inputs: [vec(3)],
+    },
+  ],
+  SlidingWindow: [
+    { params: { Length: 5, Step: 2 }, inputs: [vec(3)] },
+    { params: { Length: 4, WindowFunction: "hann" }, inputs: [vec(2)] },
+  ],
+  ArtifactRejection: [
+    { params: {}, inputs: [mat(20, 3)] },
+    {
+      params: { Mode: "soft", RailLow: -2, RailHigh: 2, DriftThreshold: 0.5 },
+      inputs: [mat(6, 2)],
+    },
+  ],
+  VectorialFunction: [
+    {
+      params: { Operation: "subtract" },
+      inputs: [mat(2, 3), vec(3)],
+      pattern: [0, 1, 0, 0, 1, 1, 0],
+    },
+    { params: { Operation: "rotate", Roll: 0.3, Pitch: -1, Yaw: 2 }, inputs: [vec(6)] },
+    { params: { Operation: "norm" }, inputs: [mat(3, 2)] },
+    { params: { Operation: "integrate" }, inputs: [mat(2, 2)] },
+    { params: { Operation: "integrate", Integration: "sum" }, inputs: [vec(3)] },
+    { params: { Operation: "cross" }, inputs: [vec(3), vec(3)], pattern: [1, 0, 0, 1, 0] },
+    { params: { Operation: "dot" }, inputs: [mat(2, 4), vec(4)], pattern: [0, 1, 1, 0, 0] },
+    {
+      params: {
+        Operation: "matmul",
+        Matrix: [
+          [1, 2],
+          [3, 4],
+          [5, 6],
+        ],
+      },
+      inputs: [vec(2)],
+    },
+    { params: { Operation: "wrench" }, inputs: [vec(6), vec(3)], pattern: [1, 0, 0, 1, 0, 1] },
+  ],
   Resampler: {
     params: { Mode: "mean" },
     inputs: [vec(3), timer(25)],
@@ -91,14 +194,139 @@ const SETUPS: Record<string, Setup> = {
     pattern: [1, 0, 2, 2, 1, 0, 0, 2, 1, 1, 2],
   },
   Splitter: { params: { Parts: { a: [3, 0], b: [1, 1, 2] } }, inputs: [vec(4)] },
-  Projector: { params: { Indices: [2, 0, 2] }, inputs: [{ shape: matrixShape(3, 3) }] },
+  Projector: { params: { Indices: [2, 0, 2] }, inputs: [mat(3, 3)] },
+  Buffer: [
+    {
+      params: { Stream: true },
+      inputs: [vec(2), vec(3, 25)],
+      pattern: [1, 0, 1, 1, 0, 0, 1, 1, 1],
+      // Every third trigger event stops (all NaN); the others alternate two targets.
+      values: (i, port, size) =>
+        port === 0
+          ? i % 3 === 0
+            ? [NaN, NaN]
+            : i % 2 === 0
+              ? [1, 0]
+              : [0, 1]
+          : smooth(i, port, size),
+    },
+    {
+      params: { Stream: true, MaxRows: 7 },
+      inputs: [vec(1), mat(2, 2)],
+      pattern: [0, 1, 1, 1, 0, 1, 1],
+    },
+  ],
+  ChannelSelector: [
+    { params: { Active: [0, 2], Inactive: "hold" }, inputs: [mat(2, 3)] },
+    { params: { Active: [1], Inactive: "nan" }, inputs: [vec(3)] },
+  ],
+  Selector: [
+    { params: { Row: -1, Columns: [2, 0] }, inputs: [mat(3, 3)] },
+    { params: {}, inputs: [vec(3)] },
+  ],
+  Switch: {
+    params: { Active: 1 },
+    inputs: [vec(2), vec(2, 50), vec(2, 10)],
+    pattern: [0, 1, 1, 2, 0, 1, 2, 2],
+  },
   Logger: {
     params: { Folder: "logs" },
-    inputs: [vec(2), timer(10), { shape: matrixShape(2, 2) }],
+    inputs: [vec(2), timer(10), mat(2, 2)],
     pattern: [0, 1, 1, 2, 0, 2],
   },
   Sink: { params: {}, inputs: [vec(2), timer(10)], pattern: [0, 1, 1], silent: true },
-  Busy: { params: { Milliseconds: 0, Every: 3 }, inputs: [vec(2)] },
+  ControlAlgorithm: {
+    params: { Strategy: "stepwise", SlewRate: 50, Timeout: 0 },
+    inputs: [vec(3)],
+  },
+  // Setups that end idle (no capture or trial in progress): `reset` would send the stop.
+  Trigger: {
+    params: {
+      Labels: { rest: [0, 0], fist: [1, 0], open: [0, 1] },
+      Initial: "fist",
+      Condition: { Channel: 1, Above: 0.5 },
+      Schedule: { Sequence: ["open", "rest"], Seconds: 0.01, Pause: 0.005, Repetitions: 2 },
+    },
+    inputs: [vec(2)],
+    values: (i) => [Math.sin(i), i % 7 < 3 ? 1 : 0],
+  },
+  Stimulus: [
+    {
+      params: {
+        Labels: { rest: [0, 0], fist: [1, 0], open: [0, 1] },
+        Tasks: ["fist", "open", { Label: "pinch", Target: [1, 1] }],
+        Rest: 0.002,
+        Rise: 0.002,
+        Hold: 0.001,
+        Capture: 0.003,
+        Fall: 0.002,
+        Autostart: true,
+      },
+      inputs: [timer(1000)],
+    },
+    {
+      params: {
+        Tasks: [
+          { Label: "a", Target: [1] },
+          { Label: "b", Target: [2] },
+        ],
+        Repetitions: 2,
+        Shuffle: true,
+        Rest: 0.001,
+        Rise: 0,
+        Hold: 0,
+        Capture: 0.005,
+        Fall: 0.001,
+        Autostart: true,
+      },
+      inputs: [timer(1000), vec(1, 10)],
+      pattern: [0, 0, 0, 1],
+    },
+  ],
+  TAC: [
+    {
+      params: {
+        Targets: [
+          [0.5, -0.5],
+          [0, 0.2],
+          [1, 1],
+        ],
+        Tolerance: 0.5,
+        Dwell: 0.002,
+        TimeLimit: 0.008,
+        Pause: 0.001,
+        Autostart: true,
+      },
+      inputs: [vec(2)],
+    },
+    {
+      params: {
+        Tolerance: [0.6, 1],
+        Metric: "box",
+        Dwell: 0.002,
+        TimeLimit: 0.006,
+        Autostart: true,
+      },
+      inputs: [vec(2), vec(2, 10)],
+      pattern: [1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0],
+      // Targets at events 0 and 22, all NaN (end of trial) at 11 and 33.
+      values: (i, port, size) =>
+        port === 1 ? (i % 22 === 0 ? [0.5, 0] : [NaN, NaN]) : smooth(i, port, size),
+    },
+  ],
+  Busy: {
+    params: { Milliseconds: 0, Every: 3 },
+    inputs: [vec(2)],
+    fuzzKeep: {
+      keys: ["Milliseconds"],
+      reason: "it spins that long by design (up to 10 s per call would slow the test down)",
+    },
+  },
+};
+
+const setupsOf = (type: string): Setup[] => {
+  const s = SETUPS[type];
+  return s === undefined ? [] : Array.isArray(s) ? s : [s];
 };
 
 interface Event {
@@ -110,12 +338,12 @@ interface Event {
 function makeEvents(s: Setup): Event[] {
   const n = s.events ?? 40;
   const pattern = s.pattern ?? [0];
+  const values = s.values ?? smooth;
   const out: Event[] = [];
   for (let i = 0; i < n; i++) {
     const port = pattern[i % pattern.length]!;
     const size = shapeSize(s.inputs[port]!.shape);
-    const v = Array.from({ length: size }, (_, k) => Math.sin(1.3 * i + 0.7 * k) * (1 + k));
-    out.push({ port, t: i / 1000, v });
+    out.push({ port, t: i / 1000, v: values(i, port, size) });
   }
   return out;
 }
@@ -166,6 +394,408 @@ function feedGrouped(h: BlockHarness, s: Setup, events: Event[]): void {
   }
 }
 
+// ---------------------------------------------------------------------------------------------
+// Garbage params through the loader and the runtime
+
+/** Errors that mean a bug in the block, not a refused value. */
+function internal(e: unknown): boolean {
+  return (
+    e instanceof TypeError ||
+    e instanceof RangeError ||
+    e instanceof ReferenceError ||
+    e instanceof SyntaxError ||
+    (e instanceof Error && e.constructor.name === "RuntimeError") // a wasm trap
+  );
+}
+
+interface Failure {
+  stage: string;
+  error: string;
+}
+
+/** A source of any shape for the fuzz pipelines: on every tick, values depending on the time. */
+const FuzzSource = defineBlock({
+  type: "FuzzSource",
+  category: "Testing",
+  summary: "Test source of a given shape.",
+  help: "Emits one value of shape [Rows, Cols] per tick of its timer (contract test only).",
+  params: z.strictObject({
+    Rows: z.number().int().min(1).describe("rows"),
+    Cols: z.number().int().min(1).describe("columns"),
+  }),
+  inputs: { min: 1, max: 1 },
+  create(ctx, p) {
+    const out = ctx.output(matrixShape(p.Rows, p.Cols));
+    const size = p.Rows * p.Cols;
+    return {
+      process(f) {
+        const o = out.frame(f.n);
+        for (let e = 0; e < f.n; e++) {
+          const t = f.t[e]!;
+          o.t[e] = t;
+          for (let k = 0; k < size; k++) o.v[e * size + k] = Math.sin(97 * t + k) * (k + 1);
+        }
+        out.emit(o);
+      },
+    };
+  },
+});
+
+/** Wraps a definition so that every internal error it raises is recorded in `failures`. */
+function guarded(def: AnyBlockDefinition, list: Failure[]): AnyBlockDefinition {
+  const failures = {
+    push(f: Failure): void {
+      if (!list.some((x) => x.stage === f.stage && x.error === f.error)) list.push(f);
+    },
+  };
+  const guard = <T>(stage: string, fn: () => T): T => {
+    try {
+      return fn();
+    } catch (e) {
+      if (internal(e)) failures.push({ stage, error: `${(e as Error).name}: ${errorMessage(e)}` });
+      throw e;
+    }
+  };
+  const wrapInstance = (inst: BlockInstance): BlockInstance => {
+    const w: BlockInstance = {};
+    const methods = ["process", "start", "stop", "reset", "dispose", "setParam"] as const;
+    for (const m of methods) {
+      const f = inst[m] as ((...a: unknown[]) => unknown) | undefined;
+      if (f)
+        (w as Record<string, unknown>)[m] = (...a: unknown[]) => guard(m, () => f.apply(inst, a));
+    }
+    if (inst.actions) {
+      w.actions = Object.fromEntries(
+        Object.entries(inst.actions).map(([name, a]) => [
+          name,
+          { ...a, run: (arg?: unknown) => guard(`action ${name}`, () => a.run(arg)) },
+        ]),
+      );
+    }
+    return w;
+  };
+  const legacy = def.legacyParams;
+  return {
+    ...def,
+    ...(legacy
+      ? {
+          legacyParams: (args: readonly string[]) => {
+            try {
+              return legacy(args);
+            } catch (e) {
+              if (!(e instanceof LegacyParamsError) && !(e instanceof BlockConfigError)) {
+                failures.push({
+                  stage: `legacyParams(${JSON.stringify(args).slice(0, 80)})`,
+                  error: `${(e as Error).name}: ${errorMessage(e)}`,
+                });
+              }
+              throw e;
+            }
+          },
+        }
+      : {}),
+    async create(ctx: BlockContext, params: unknown) {
+      const g = Object.create(ctx) as BlockContext & Record<string, unknown>;
+      g.every = (hz: number, tick: (t: number) => void) =>
+        ctx.every(hz, (t) => guard("timer", () => tick(t)));
+      g.at = (t: number, fn: (t: number) => void) =>
+        ctx.at(t, (x) => guard("one-shot", () => fn(x)));
+      try {
+        return wrapInstance(await def.create(g, params));
+      } catch (e) {
+        if (!(e instanceof BlockConfigError)) {
+          failures.push({ stage: "create", error: `${(e as Error).name}: ${errorMessage(e)}` });
+        }
+        throw e;
+      }
+    },
+  };
+}
+
+// Sizes that cannot be allocated (1e12 or more), never ones that merely take seconds (1e8), so
+// that a missing bound shows as an error here instead of a slow test.
+const NUMBERS = [
+  0,
+  -0,
+  1,
+  -1,
+  2,
+  3,
+  0.5,
+  -0.5,
+  6,
+  100,
+  65536,
+  -1e5,
+  1e12,
+  1e15,
+  1e300,
+  -1e300,
+  1e-300,
+  Number.MAX_SAFE_INTEGER,
+  2 ** 53,
+  NaN,
+  Infinity,
+  -Infinity,
+];
+const STRINGS = [
+  "",
+  " ",
+  "x",
+  "in0",
+  "in1",
+  "Src0",
+  "zero",
+  "hold",
+  "add",
+  "multiply",
+  "rotate",
+  "abs",
+  "mean",
+  "1;2;3",
+  "a:b",
+  ".inf",
+  "[1, 2]",
+  "é\u0000",
+];
+const weirdNumber = fc.oneof(
+  fc.constantFrom(...NUMBERS),
+  fc.integer({ min: -20, max: 20 }),
+  fc.double({ noDefaultInfinity: false }),
+);
+const leaf = fc.oneof(
+  { weight: 4, arbitrary: weirdNumber },
+  { weight: 2, arbitrary: fc.constantFrom(...STRINGS) },
+  { weight: 1, arbitrary: fc.string({ maxLength: 10 }) },
+  { weight: 1, arbitrary: fc.boolean() },
+  { weight: 1, arbitrary: fc.constant(null) },
+);
+const { anyValue } = fc.letrec((tie) => ({
+  anyValue: fc.oneof(
+    { depthSize: "small", withCrossShrink: true },
+    leaf,
+    fc.array(tie("anyValue"), { maxLength: 6 }),
+    fc.dictionary(fc.string({ maxLength: 6 }), tie("anyValue"), { maxKeys: 4 }),
+  ),
+}));
+/** Arrays and objects at the extremes: empty, huge, deeply nested. */
+const extreme = fc.oneof(
+  fc.constant([]),
+  fc.constant({}),
+  fc.constant(new Array<number>(20_000).fill(1)),
+  fc.constant(new Array<number[]>(300).fill([1, 2, 3])),
+  fc.constant([new Array<number>(300).fill(0.5)]),
+  fc.nat({ max: 40 }).map((d) => {
+    let o: unknown = 1;
+    for (let i = 0; i < d; i++) o = i % 2 === 0 ? { a: o } : [o];
+    return o;
+  }),
+);
+const positional = fc.array(
+  fc.oneof(
+    fc.constantFrom(
+      "multiply:5",
+      "abs:0",
+      "subtract",
+      "rotation:1;2",
+      "rotation:1;2;3",
+      "matrix_multiply",
+      "1;2;3",
+      "0.1;0.2, 1;-0.5",
+      ":",
+      "a:b:c",
+      "1e999",
+      "-1",
+      "NaN",
+      "timerBlockName:",
+      "rest:0;0;1",
+      "",
+    ),
+    fc.string({ maxLength: 12 }),
+  ),
+  { maxLength: 5 },
+);
+
+function paramsArbitrary(def: AnyBlockDefinition, s: Setup): fc.Arbitrary<unknown> {
+  const kept = s.fuzzKeep?.keys ?? [];
+  const keys = (objectKeys(def.params) ?? []).filter((k) => !kept.includes(k));
+  const base = (s.params ?? {}) as Record<string, unknown>;
+  const value = fc.oneof(
+    { weight: 3, arbitrary: weirdNumber },
+    { weight: 4, arbitrary: anyValue },
+    { weight: 1, arbitrary: extreme },
+  );
+  const options: fc.WeightedArbitrary<unknown>[] = [
+    ...(kept.length > 0
+      ? []
+      : [
+          { weight: 2, arbitrary: anyValue },
+          { weight: 1, arbitrary: extreme },
+        ]),
+    { weight: 2, arbitrary: positional },
+    {
+      weight: 2,
+      arbitrary: fc
+        .dictionary(fc.constantFrom(...keys, "Unknown", "extra"), value, { maxKeys: 4 })
+        .map((d) => ({ ...d, ...Object.fromEntries(kept.map((k) => [k, base[k]])) })),
+    },
+  ];
+  if (keys.length > 0) {
+    // The example with one or two of its params replaced by garbage.
+    options.push({
+      weight: 8,
+      arbitrary: fc
+        .array(fc.tuple(fc.constantFrom(...keys), value), { minLength: 1, maxLength: 2 })
+        .map((kv) => ({ ...base, ...Object.fromEntries(kv) })),
+    });
+  }
+  return fc.oneof(...options);
+}
+
+const noFiles: Resources = {
+  resolve: (p) => p,
+  readText: (p) => Promise.reject(new Error(`ENOENT: no such file '${p}'`)),
+  writeText: () => Promise.resolve(),
+};
+
+/** The pipeline: sources of the setup's input shapes, then the block with these params. */
+function fuzzPipeline(def: AnyBlockDefinition, s: Setup, params: unknown): string {
+  const doc: Record<string, unknown> = { Clock: { Type: "ScheduledTimer", DesiredRate: 100 } };
+  const inputs = s.inputs.map((inp, i) => {
+    const name = `Src${i}`;
+    doc[name] = inp.isTimer
+      ? { Type: "ScheduledTimer", DesiredRate: inp.rate ?? 100 }
+      : {
+          Type: "FuzzSource",
+          DesiredRate: inp.rate ?? 100,
+          Inputs: ["Clock"],
+          Params: { Rows: inp.shape.rows, Cols: inp.shape.cols },
+        };
+    return name;
+  });
+  doc.Block = {
+    Type: def.type,
+    ...(def.timer || def.requiresRate ? { DesiredRate: 100 } : {}),
+    ...(inputs.length > 0 ? { Inputs: inputs } : {}),
+    Params: params,
+  };
+  return stringify(doc);
+}
+
+const ACTION_ARGS: unknown[] = [
+  undefined,
+  -1,
+  0,
+  1,
+  1e9,
+  NaN,
+  "x",
+  "",
+  [],
+  [1e9],
+  [0, 1],
+  {},
+  null,
+];
+
+/** Loads, instantiates and briefly runs the pipeline; returns what went wrong inside the block. */
+async function tryGarbage(def: AnyBlockDefinition, s: Setup, params: unknown): Promise<Failure[]> {
+  const failures: Failure[] = [];
+  const catalog = createCatalog([
+    ...BLOCKS.map((b) => (b.type === def.type ? guarded(b, failures) : b)),
+    FuzzSource,
+  ]);
+  const yaml = fuzzPipeline(def, s, params);
+  let loaded;
+  try {
+    loaded = loadPipeline(yaml, "fuzz.yaml", catalog);
+  } catch (e) {
+    return [{ stage: "loadPipeline threw", error: `${(e as Error).name}: ${errorMessage(e)}` }];
+  }
+  if (!loaded.spec) return failures;
+  const clock = new VirtualClock(0);
+  let created;
+  try {
+    created = await Runtime.create({
+      spec: loaded.spec,
+      catalog,
+      clock,
+      virtual: true,
+      resources: s.resources ?? noFiles,
+      ignorePlacement: true,
+    });
+  } catch (e) {
+    return [{ stage: "Runtime.create threw", error: `${(e as Error).name}: ${errorMessage(e)}` }];
+  }
+  const rt = created.runtime;
+  if (!rt) {
+    for (const d of created.diagnostics) {
+      if (d.message.trim() === "") failures.push({ stage: "diagnostic", error: "empty message" });
+    }
+    return failures;
+  }
+  try {
+    rt.start();
+    runVirtual(rt, clock, 0.05, 2000);
+    const node = rt.node("Block")!;
+    for (const name of Object.keys(node.instance.actions ?? {})) {
+      for (const arg of ACTION_ARGS) {
+        try {
+          rt.invoke("Block", name, arg);
+        } catch {
+          // refusals are fine; internal errors were recorded by the guard
+        }
+      }
+    }
+    for (const p of (def.live ?? []).filter((k) => !(s.fuzzKeep?.keys ?? []).includes(k))) {
+      for (const v of [0, -1, 1e9, [], [1e9], "x", true]) {
+        try {
+          rt.setParam("Block", p, v);
+        } catch {
+          // idem
+        }
+      }
+    }
+    runVirtual(rt, clock, 0.1, 2000);
+  } finally {
+    rt.dispose();
+  }
+  return failures;
+}
+
+/**
+ * The example params with one number param (or one element of a number-list param) set to each
+ * extreme value in turn: a deterministic sweep next to the random garbage.
+ */
+function extremeVariants(def: AnyBlockDefinition, s: Setup): unknown[] {
+  const kept = s.fuzzKeep?.keys ?? [];
+  const schema = z.toJSONSchema(def.params, { io: "input" }) as {
+    properties?: Record<string, unknown>;
+  };
+  const base = (s.params ?? {}) as Record<string, unknown>;
+  const out: unknown[] = [];
+  for (const [k, prop] of Object.entries(schema.properties ?? {})) {
+    if (kept.includes(k)) continue;
+    const text = JSON.stringify(prop);
+    const numeric = /"type":"(number|integer)"/.test(text);
+    const list = /"type":"array"/.test(text);
+    for (const v of NUMBERS) {
+      if (numeric) out.push({ ...base, [k]: v });
+      if (list) {
+        const ex = base[k];
+        out.push({ ...base, [k]: Array.isArray(ex) && ex.length > 0 ? [v, ...ex.slice(1)] : [v] });
+      }
+    }
+    if (list) out.push({ ...base, [k]: [] }, { ...base, [k]: new Array<number>(20_000).fill(1) });
+  }
+  return out;
+}
+
+const describeFailure = (params: unknown, f: Failure): string =>
+  `${JSON.stringify(params)?.slice(0, 160)} → ${f.stage}: ${f.error}`;
+const isKnown = (s: Setup, failure: string): boolean =>
+  (s.known ?? []).some((k) => k.pattern.test(failure));
+
 describe("block contract", () => {
   test("every catalog block has a setup here", () => {
     const missing = BLOCKS.map((b) => b.type).filter((t) => !(t in SETUPS));
@@ -174,8 +804,19 @@ describe("block contract", () => {
     expect(unknown).toEqual([]);
   });
 
+  test("loader: `Params: []` on a block whose positional form needs arguments is a diagnostic", () => {
+    const r = loadPipeline(
+      "T: { Type: ScheduledTimer, DesiredRate: 10 }\n" +
+        "S: { Type: SinGenerator, Inputs: [T] }\n" +
+        "P: { Type: Projector, Inputs: [S], Params: [] }\n",
+      "t.yaml",
+      createCatalog(BLOCKS),
+    );
+    expect(r.diagnostics.some((d) => d.block === "P")).toBe(true);
+  });
+
   describe.each(BLOCKS.map((def) => [def.type, def] as const))("%s", (type, def) => {
-    const setup = SETUPS[type];
+    const setups = setupsOf(type);
 
     test("docs: summary, help, panel and a description for every param; JSON Schema", () => {
       expect(def.summary.trim()).not.toBe("");
@@ -197,39 +838,92 @@ describe("block contract", () => {
       if (def.legacyParams) expect(def.legacyForm ?? "").not.toBe("");
     });
 
-    test("the setup's params validate and its outputs are declared", async () => {
-      expect(setup).toBeDefined();
-      const parsed = def.params.safeParse(setup!.params);
-      expect(parsed.success, JSON.stringify(parsed.error?.issues)).toBe(true);
-      const h = await harness(def, setup!);
-      expect(h.ports.map((p) => p.name)).toEqual([...outputNames(def, h.params)]);
-      if ((def.live ?? []).length > 0) expect(h.instance.setParam).toBeTypeOf("function");
+    test("the setups' params validate and their outputs are declared", async () => {
+      expect(setups.length).toBeGreaterThan(0);
+      for (const setup of setups) {
+        const parsed = def.params.safeParse(setup.params);
+        expect(parsed.success, JSON.stringify(parsed.error?.issues)).toBe(true);
+        const h = await harness(def, setup);
+        expect(h.ports.map((p) => p.name)).toEqual([...outputNames(def, h.params)]);
+        if ((def.live ?? []).length > 0) expect(h.instance.setParam).toBeTypeOf("function");
+        h.instance.dispose?.();
+      }
     });
 
     test("one frame of N events = N frames of one event; after reset the output repeats", async () => {
-      const s = setup!;
-      if (s.inputs.length === 0) return; // sources paced by their own timer: nothing to batch
-      const events = makeEvents(s);
-      const one = await harness(def, s);
-      feedOneByOne(one, s, events);
-      const expected = snapshot(one);
-      // The comparison means something only if the block produced something.
-      const produced = Object.values(expected).reduce(
-        (n, x) => n + (Array.isArray(x) ? x.length : x.t.length),
-        0,
-      );
-      if (!s.silent) expect(produced).toBeGreaterThan(0);
+      for (const s of setups) {
+        if (s.inputs.length === 0) continue; // sources paced by their own timer: nothing to batch
+        const events = makeEvents(s);
+        const one = await harness(def, s);
+        feedOneByOne(one, s, events);
+        const expected = snapshot(one);
+        // The comparison means something only if the block produced something.
+        const produced = Object.values(expected).reduce(
+          (n, x) => n + (Array.isArray(x) ? x.length : x.t.length),
+          0,
+        );
+        if (!s.silent) expect(produced, JSON.stringify(s.params)).toBeGreaterThan(0);
 
-      const grouped = await harness(def, s);
-      feedGrouped(grouped, s, events);
-      expect(snapshot(grouped)).toEqual(expected);
+        const grouped = await harness(def, s);
+        feedGrouped(grouped, s, events);
+        expect(snapshot(grouped), JSON.stringify(s.params)).toEqual(expected);
 
-      clearAll(one);
-      one.instance.reset?.();
-      feedOneByOne(one, s, events);
-      expect(snapshot(one)).toEqual(expected);
-      one.instance.dispose?.();
-      grouped.instance.dispose?.();
+        clearAll(one);
+        one.instance.reset?.();
+        feedOneByOne(one, s, events);
+        expect(snapshot(one), `after reset, ${JSON.stringify(s.params)}`).toEqual(expected);
+        one.instance.dispose?.();
+        grouped.instance.dispose?.();
+      }
     });
+
+    test("dispose() twice is harmless, before and after start", async () => {
+      for (const s of setups) {
+        const h = await BlockHarness.create(def, s.params, {
+          inputs: s.inputs,
+          now: 0,
+          ...(s.resources ? { resources: s.resources } : {}),
+        });
+        expect(() => h.instance.dispose?.()).not.toThrow();
+        expect(() => h.instance.dispose?.()).not.toThrow();
+        const started = await harness(def, s);
+        if (s.inputs.length > 0) feedOneByOne(started, s, makeEvents(s).slice(0, 5));
+        started.instance.stop?.();
+        expect(() => started.instance.dispose?.()).not.toThrow();
+        expect(() => started.instance.dispose?.()).not.toThrow();
+      }
+    });
+
+    test("garbage params are refused by zod, the positional form or a BlockConfigError — never an internal error", async () => {
+      expect(setups.length, `${type} has no setup in SETUPS`).toBeGreaterThan(0);
+      const s = setups[0]!;
+      await fc.assert(
+        fc.asyncProperty(paramsArbitrary(def, s), async (params) => {
+          const failures = (await tryGarbage(def, s, params)).filter(
+            (f) => !isKnown(s, describeFailure(params, f)),
+          );
+          if (failures.length > 0) {
+            throw new Error(failures.map((f) => `${f.stage}: ${f.error}`).join("\n"));
+          }
+        }),
+        { numRuns: 100, seed: 20261123 },
+      );
+    }, 60_000);
+
+    test("each number param at the extremes (0, −1, 1e15, NaN, ±∞, …) is refused or works", async () => {
+      expect(setups.length, `${type} has no setup in SETUPS`).toBeGreaterThan(0);
+      const s = setups[0]!;
+      const found: string[] = [];
+      for (const params of extremeVariants(def, s)) {
+        for (const f of await tryGarbage(def, s, params)) found.push(describeFailure(params, f));
+      }
+      expect(found.filter((f) => !isKnown(s, f))).toEqual([]);
+      for (const k of s.known ?? []) {
+        expect(
+          found.some((f) => k.pattern.test(f)),
+          `known issue no longer occurs, remove it from SETUPS.${type}.known: ${k.reason}`,
+        ).toBe(true);
+      }
+    }, 60_000);
   });
 });

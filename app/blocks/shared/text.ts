@@ -21,3 +21,23 @@ export class TextThrottle {
     this.last = -Infinity;
   }
 }
+
+/** A whole number with thousands separators: 3400 → "3,400" (the same in every locale). */
+export function formatCount(n: number): string {
+  const s = String(Math.trunc(Math.abs(n)));
+  const grouped = s.replace(/\B(?=(\d{3})+(?!\d))/g, ",");
+  return n < 0 ? `-${grouped}` : grouped;
+}
+
+/** "1 row", "3,400 rows". */
+export const plural = (n: number, noun: string): string =>
+  `${formatCount(n)} ${noun}${n === 1 ? "" : "s"}`;
+
+/** A short vector for status texts: [1, 0, 0.5] (values in shortest round-trip form). */
+export function formatVector(v: ArrayLike<number>, max = 8): string {
+  const parts: string[] = [];
+  const n = Math.min(v.length, max);
+  for (let i = 0; i < n; i++) parts.push(String(v[i]));
+  if (v.length > max) parts.push(`… (${v.length} values)`);
+  return `[${parts.join(", ")}]`;
+}

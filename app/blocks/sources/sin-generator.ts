@@ -27,6 +27,7 @@ export const SinGenerator = defineBlock({
       .number()
       .int()
       .min(1)
+      .max(4096)
       .default(1)
       .describe("Number of sine components, i.e. the width of the output vector"),
     Amplitude: z.number().default(1).describe("Peak amplitude of every component"),

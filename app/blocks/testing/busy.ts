@@ -13,7 +13,12 @@ export const Busy = defineBlock({
     "desired rate marks it stumbling (magenta); spinning on every call for longer than a period " +
     "makes everything after it lag (red). Both params can be changed while running.",
   params: z.strictObject({
-    Milliseconds: z.number().min(0).default(10).describe("How long to spin on a slow call, in ms"),
+    Milliseconds: z
+      .number()
+      .min(0)
+      .max(10_000)
+      .default(10)
+      .describe("How long to spin on a slow call, in ms (at most 10 s)"),
     Every: z
       .number()
       .int()
