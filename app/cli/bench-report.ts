@@ -409,6 +409,14 @@ export function targets(results: WorkloadResult[]): TargetRow[] {
     ),
   );
   rows.push(cpuRow("hdemg", "High-density EMG, 256 ch @ 2048 Hz", "not reported", 10));
+  rows.push(
+    cpuRow(
+      "hdemg-features",
+      "High-density EMG features (MAV, WL, ZC, SSC on 200 ms windows every 25 ms), 256 ch @ 2048 Hz",
+      "not reported",
+      10,
+    ),
+  );
   {
     const r = pipeline(results, "delsys");
     rows.push(

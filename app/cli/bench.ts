@@ -58,7 +58,7 @@ Markdown tables and writes DIR/latest.json and DIR/latest.md (default DIR: bench
   --duration S  steady-state seconds per pipeline after the warm-up (default 30; the timer
                 workloads use half, at least 2)
   --warmup S    seconds excluded at the start of each real-time run (default 5)
-  --only LIST   run only these workloads: ${"myo, delsys, hdemg, timer, timer-precision, replay-32, replay-256"}
+  --only LIST   run only these workloads: ${"myo, delsys, hdemg, hdemg-features, timer, timer-precision, replay-32, replay-256"}
                 (a prefix before '-' selects a group: timer, replay)
   --out DIR     where to write latest.json and latest.md
   --quick       a smoke test: 1 s warm-up, 3 s steady state, short replays (about 40 s in all)
@@ -107,6 +107,12 @@ const WORKLOADS: WorkloadDef[] = [
     id: "hdemg",
     title: "(c) High-density EMG — 256 ch @ 2048 Hz",
     file: "hdemg.yaml",
+  },
+  {
+    kind: "pipeline",
+    id: "hdemg-features",
+    title: "(d) High-density EMG features — 256 ch @ 2048 Hz, 200 ms windows every 25 ms",
+    file: "hdemg-features.yaml",
   },
   {
     kind: "pipeline",
