@@ -4,3 +4,4 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build-wasm.sh
 node scripts/build-ts.mjs
+node scripts/build-web.mjs

@@ -18,6 +18,8 @@ step "format (prettier)"
 step "types (tsc, per runtime layer)"
 "$bin/tsc" -p tsconfig.pure.json
 "$bin/tsc" -p tsconfig.node.json
+"$bin/tsc" -p tsconfig.web.json
+"$bin/tsc" -p tsconfig.webworker.json
 
 step "rust (fmt, clippy, tests)"
 cargo fmt --manifest-path core-wasm/Cargo.toml --all -- --check

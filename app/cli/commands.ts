@@ -9,7 +9,8 @@ import { resolve } from "node:path";
 import { parseArgs } from "node:util";
 import { formatDiagnostic } from "../engine/diagnostics";
 import type { Telemetry } from "../engine/runtime/runtime";
-import { Host } from "../host/host";
+import { Host, webRoot } from "../host/host";
+import { serveStatic } from "../host/web-server";
 import { runBench } from "./bench";
 import { renderTable } from "./table";
 
@@ -34,6 +35,10 @@ Usage:
         --start T      virtual clock start time, UNIX seconds (default 0)
         --warmup S     reset the timing statistics (ΔT, lateness) after S seconds
         --telemetry-hz N  telemetry (status, rates) per second, default 20 (as the UI)
+  mosaic web [--port N] [--host ADDR] [--pipeline FILE]
+      Serves the browser build (dist/web: the UI with the engine in the page's Web Worker, on
+      simulated signals) and prints its URL; --pipeline preselects one of pipelines/ (default
+      the demo). Ctrl-C stops it.
   mosaic bench [--duration S] [--warmup S] [--only NAME[,NAME]] [--out DIR] [--quick]
       Runs the standard benchmarks and writes bench/results/*.json and *.md.
   mosaic --help | --version
@@ -252,6 +257,44 @@ async function cmdRun(args: string[]): Promise<number> {
   return code;
 }
 
+async function cmdWeb(args: string[]): Promise<number> {
+  const { values } = parseArgs({
+    args,
+    options: {
+      port: { type: "string", default: "8321" },
+      host: { type: "string", default: "127.0.0.1" },
+      pipeline: { type: "string" },
+    },
+  });
+  const port = Number(values.port);
+  if (!Number.isInteger(port) || port < 0 || port > 65535) {
+    err(`mosaic web: --port must be a port number, not '${values.port}'`);
+    return 2;
+  }
+  const root = webRoot();
+  if (!root) {
+    err("mosaic web: the browser build is missing (dist/web): run `npm run build` first");
+    return 1;
+  }
+  let server;
+  try {
+    server = await serveStatic(root, port, values.host);
+  } catch (e) {
+    err(`mosaic web: ${(e as Error).message}`);
+    return 1;
+  }
+  const url =
+    server.url + (values.pipeline ? `?pipeline=${encodeURIComponent(values.pipeline)}` : "");
+  out(`MOSAIC is at ${url}`);
+  out("(the pipeline runs in the page; Ctrl-C stops this server)");
+  await new Promise<void>((r) => {
+    process.once("SIGINT", r);
+    process.once("SIGTERM", r);
+  });
+  await server.close();
+  return 0;
+}
+
 export async function main(argv: string[]): Promise<number> {
   const [cmd, ...rest] = argv;
   switch (cmd) {
@@ -271,8 +314,12 @@ export async function main(argv: string[]): Promise<number> {
       return cmdRun(rest);
     case "bench":
       return runBench(rest);
+    case "web":
+      return cmdWeb(rest);
     default:
-      err(`mosaic: unknown command '${cmd}' (commands: validate, run, bench; see mosaic --help)`);
+      err(
+        `mosaic: unknown command '${cmd}' (commands: validate, run, web, bench; see mosaic --help)`,
+      );
       return 2;
   }
 }

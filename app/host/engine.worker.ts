@@ -16,7 +16,7 @@ import type { LogChannel, LogSink } from "../engine/runtime/logsink";
 import { Runtime } from "../engine/runtime/runtime";
 import { SabRing } from "../engine/runtime/sab-ring";
 import { runVirtual } from "../engine/runtime/virtual";
-import { RealtimeLoop } from "./loop";
+import { RealtimeLoop } from "../engine/runtime/loop";
 import { nodeResources } from "./resources";
 import { clockFromBase } from "./time-base";
 import type { HostToWorker, InitMessage, WorkerToHost } from "./worker-protocol";
@@ -153,6 +153,7 @@ function start(): void {
   }
   loop = new RealtimeLoop({
     runtime,
+    yieldNow: setImmediate,
     clock: rt.clock,
     doorbell,
     precision: init.precision,

@@ -64,6 +64,14 @@ export function defaultWorkerPath(): string {
   );
 }
 
+/** The browser build (dist/web) next to the running bundle or in the repo; undefined if not built. */
+export function webRoot(): string | undefined {
+  const found = distFile("web/index.html");
+  if (found) return dirname(found);
+  const d = join(repoRootFrom(fileURLToPath(import.meta.url)), "dist", "web");
+  return existsSync(join(d, "index.html")) ? d : undefined;
+}
+
 export function defaultWasmPath(): string {
   const found = distFile("mosaic_core_bg.wasm");
   if (found) return found;

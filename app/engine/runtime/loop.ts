@@ -1,5 +1,6 @@
 /**
- * The real-time loop of an engine worker (DESIGN.md §3 Scheduling).
+ * The real-time loop of an engine worker (DESIGN.md §3 Scheduling), for Node worker_threads and
+ * for browser Web Workers with shared memory (cross-origin isolated pages).
  *
  * Between deadlines the worker blocks in `Atomics.wait` on its doorbell and wakes slightly before
  * the deadline — "slightly" is learned from the observed wake-up overshoot, so ticks land on time
@@ -15,8 +16,8 @@
  *   (`Atomics.waitAsync`) while the next deadline is far, so a datagram wakes it at once, and only
  *   the last COARSE_S before a deadline are spent in `Atomics.wait`.
  */
-import type { Clock } from "../engine/clock";
-import type { Runtime } from "../engine/runtime/runtime";
+import type { Clock } from "../clock";
+import type { Runtime } from "./runtime";
 
 const COARSE_S = 0.002;
 const PRECISION_SPIN_S = 0.0003;
@@ -31,6 +32,8 @@ export const BELL_CONTROL = 1;
 
 export interface LoopOptions {
   runtime: Runtime;
+  /** Runs `fn` on the next turn of the event loop (Node: setImmediate; browsers: a MessageChannel). */
+  yieldNow: (fn: () => void) => void;
   clock: Clock;
   /** Int32Array(2) over a SharedArrayBuffer (see BELL_WAKE, BELL_CONTROL). */
   doorbell: Int32Array;
@@ -62,7 +65,7 @@ export class RealtimeLoop {
     if (!this.stopped) return;
     this.stopped = false;
     this.lastTelemetry = this.o.clock.now();
-    setImmediate(this.turn);
+    this.o.yieldNow(this.turn);
   }
 
   stop(): void {
@@ -107,19 +110,19 @@ export class RealtimeLoop {
       if (this.stopped) return;
       const now = clock.now();
       const remaining = this.nextDeadline() - now;
-      if (this.eventLoop && remaining > COARSE_S) {
+      if (this.eventLoop && remaining > COARSE_S && typeof Atomics.waitAsync === "function") {
         // Sleep in the event loop so that I/O callbacks run as soon as data arrives.
         const seen = Atomics.load(doorbell, BELL_WAKE);
         const r = Atomics.waitAsync(doorbell, BELL_WAKE, seen, (remaining - COARSE_S) * 1000);
         if (r.async) r.value.then(this.turn, this.turn);
-        else setImmediate(this.turn);
+        else this.o.yieldNow(this.turn);
         return;
       }
       if (
         Atomics.load(doorbell, BELL_CONTROL) !== 0 ||
         now - this.lastYield >= (this.eventLoop ? 0 : YIELD_S)
       ) {
-        setImmediate(this.turn);
+        this.o.yieldNow(this.turn);
         if (remaining > 0.0005) return;
         // A deadline is imminent: wait for it first, the event loop turns right after.
         this.sleepUntilDeadline(MAX_BLOCK_S);

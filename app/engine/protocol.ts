@@ -1,0 +1,156 @@
+/**
+ * The one UI↔engine protocol (DESIGN.md §4). The UI talks to any engine — an in-page Web Worker
+ * (browser build), the Node host over a WebSocket, Electron over IPC — with these messages only.
+ * Messages from the UI are validated at the engine's boundary (`parseUiMessage`); the UI imports
+ * nothing else from the engine but types.
+ */
+import { z } from "zod";
+import type { Diagnostic } from "./diagnostics";
+import type { Shape } from "./frame";
+import type { RuntimeEvent, Telemetry } from "./runtime/runtime";
+
+export const PROTOCOL_VERSION = 1;
+
+// ---------------------------------------------------------------------------------------------
+// UI → engine
+
+const id = z.number().int().nonnegative();
+
+export const uiMessageSchema = z.discriminatedUnion("type", [
+  z.strictObject({ type: z.literal("hello"), version: z.number().int() }),
+  /** Parses and instantiates a pipeline (stopping and disposing a previous one); does not start it. */
+  z.strictObject({
+    type: z.literal("load"),
+    id,
+    file: z.string().min(1).max(4096),
+    source: z.string().max(4_000_000),
+  }),
+  z.strictObject({ type: z.literal("start"), id }),
+  z.strictObject({ type: z.literal("stop"), id }),
+  /** A live param (validated against the block's schema by the engine). */
+  z.strictObject({
+    type: z.literal("setParam"),
+    id,
+    block: z.string().min(1),
+    param: z.string().min(1),
+    value: z.unknown(),
+  }),
+  /** A block action, or a built-in: subscribe/unsubscribe (arg: input name or index), reset. */
+  z.strictObject({
+    type: z.literal("invoke"),
+    id,
+    block: z.string().min(1),
+    action: z.string().min(1),
+    arg: z.unknown().optional(),
+  }),
+  /** Panel data on: the block's frames on `port`, at most `maxRate` events per second. */
+  z.strictObject({
+    type: z.literal("watch"),
+    id,
+    block: z.string().min(1),
+    port: z.string().optional(),
+    maxRate: z.number().positive().max(100_000).optional(),
+  }),
+  z.strictObject({
+    type: z.literal("unwatch"),
+    id,
+    block: z.string().min(1),
+    port: z.string().optional(),
+  }),
+]);
+
+export type UiMessage = z.infer<typeof uiMessageSchema>;
+
+/** Validates a message from the UI; returns it or a sentence saying what is wrong. */
+export function parseUiMessage(
+  raw: unknown,
+): { ok: true; msg: UiMessage } | { ok: false; error: string } {
+  const r = uiMessageSchema.safeParse(raw);
+  if (r.success) return { ok: true, msg: r.data };
+  const issue = r.error.issues[0]!;
+  const where = issue.path.length ? ` at ${issue.path.map(String).join(".")}` : "";
+  return { ok: false, error: `invalid message${where}: ${issue.message}` };
+}
+
+// ---------------------------------------------------------------------------------------------
+// engine → UI
+
+export interface ActionInfo {
+  name: string;
+  label: string;
+  description?: string;
+}
+
+export interface InputRefInfo {
+  source: string;
+  block: string;
+  port: string;
+  subscribed: boolean;
+}
+
+export interface BlockInfo {
+  name: string;
+  type: string;
+  category: string;
+  summary: string;
+  help: string;
+  worker: string;
+  timer: boolean;
+  desiredRate: number;
+  inputs: InputRefInfo[];
+  outputs: { name: string; shape: Shape }[];
+  views: string[];
+  panel: string;
+  /** Params that can be changed while running. */
+  live: string[];
+  /** Current (validated) params. */
+  params: Record<string, unknown>;
+  /** JSON Schema (draft 2020-12, input side) of the params: the UI builds its form from it. */
+  paramsSchema: unknown;
+  actions: ActionInfo[];
+  layout?: { x: number; y: number };
+  path?: string;
+}
+
+export interface GraphInfo {
+  file: string;
+  blocks: BlockInfo[];
+}
+
+export type EngineState = "empty" | "loaded" | "running" | "stopped" | "finished";
+
+export interface DataMessage {
+  type: "data";
+  block: string;
+  port: string;
+  rows: number;
+  cols: number;
+  /** Event timestamps (UNIX seconds). */
+  t: Float64Array;
+  /** Values, row-major, `rows * cols` per event. */
+  v: Float64Array;
+  /** Events left out to honour `maxRate` since the previous message. */
+  skipped: number;
+}
+
+export type EngineMessage =
+  | { type: "hello"; version: number; engine: string; sharedMemory: boolean }
+  | {
+      type: "reply";
+      id: number;
+      ok: boolean;
+      message?: string;
+      diagnostics?: Diagnostic[];
+      graph?: GraphInfo;
+    }
+  | { type: "state"; state: EngineState; file?: string }
+  | { type: "telemetry"; telemetry: Telemetry }
+  | { type: "event"; event: RuntimeEvent }
+  | DataMessage;
+
+/** What the UI holds to talk to an engine, whatever the transport. */
+export interface EngineConnection {
+  send(msg: UiMessage): void;
+  onMessage(handler: (msg: EngineMessage) => void): () => void;
+  close(): void;
+}

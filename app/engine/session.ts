@@ -1,0 +1,391 @@
+/**
+ * An engine session: serves the UI protocol (app/engine/protocol.ts) for one pipeline at a time.
+ * Runs wherever a single runtime runs — the browser build's Web Worker now, the Node host and
+ * Electron later — with the platform's clock, files, logs and real-time loop injected.
+ */
+import { z } from "zod";
+import type { Catalog } from "./catalog";
+import type { Clock } from "./clock";
+import { errorMessage, type Diagnostic } from "./diagnostics";
+import type { Frame } from "./frame";
+import { loadPipeline, type PipelineSpec } from "./pipeline/loader";
+import {
+  PROTOCOL_VERSION,
+  parseUiMessage,
+  type BlockInfo,
+  type EngineMessage,
+  type EngineState,
+  type GraphInfo,
+  type UiMessage,
+} from "./protocol";
+import type { LogSink } from "./runtime/logsink";
+import { Runtime } from "./runtime/runtime";
+import type { Resources } from "./block";
+
+export interface LoopHandle {
+  stop(): void;
+  /** Re-plan the wait now (timers changed, a message was handled). */
+  wake(): void;
+}
+
+export interface LoopHooks {
+  telemetryIntervalS: number;
+  onTelemetry(): void;
+  onFinished(): void;
+}
+
+export interface SessionPlatform {
+  /** Name reported in `hello` (e.g. "browser worker", "node host"). */
+  engine: string;
+  sharedMemory: boolean;
+  clock(): Clock;
+  /** File access relative to the pipeline file's folder. */
+  resources(file: string): Resources;
+  logs?(file: string): LogSink | undefined;
+  startLoop(rt: Runtime, hooks: LoopHooks): LoopHandle;
+  post(msg: EngineMessage, transfer?: ArrayBuffer[]): void;
+}
+
+const BUILT_IN_ACTIONS = [
+  { name: "reset", label: "Reset", description: "Clear the block's state" },
+  {
+    name: "subscribe",
+    label: "Subscribe input",
+    description: "Start delivering one of its inputs",
+  },
+  {
+    name: "unsubscribe",
+    label: "Unsubscribe input",
+    description: "Stop delivering one of its inputs",
+  },
+];
+
+/** Panel data of one watched output: decimated to `maxRate`, flushed with the telemetry. */
+class Watch {
+  t = new Float64Array(64);
+  v: Float64Array;
+  n = 0;
+  skipped = 0;
+  private every = 1;
+  private count = 0;
+  readonly stride: number;
+  untap: () => void = () => {};
+
+  constructor(
+    readonly block: string,
+    readonly port: string,
+    readonly rows: number,
+    readonly cols: number,
+    rate: number,
+    maxRate: number,
+  ) {
+    this.stride = rows * cols;
+    this.v = new Float64Array(64 * this.stride);
+    this.every = rate > maxRate ? Math.ceil(rate / maxRate) : 1;
+  }
+
+  add(f: Frame): void {
+    for (let i = 0; i < f.n; i++) {
+      if (this.count++ % this.every !== 0) {
+        this.skipped++;
+        continue;
+      }
+      if (this.n === this.t.length) {
+        const t = new Float64Array(this.t.length * 2);
+        t.set(this.t);
+        this.t = t;
+        const v = new Float64Array(this.v.length * 2);
+        v.set(this.v);
+        this.v = v;
+      }
+      this.t[this.n] = f.t[i]!;
+      const s = this.stride;
+      const src = i * s;
+      const dst = this.n * s;
+      for (let k = 0; k < s; k++) this.v[dst + k] = f.v[src + k]!;
+      this.n++;
+    }
+  }
+
+  take(): EngineMessage | null {
+    if (this.n === 0) return null;
+    const msg: EngineMessage = {
+      type: "data",
+      block: this.block,
+      port: this.port,
+      rows: this.rows,
+      cols: this.cols,
+      t: this.t.slice(0, this.n),
+      v: this.v.slice(0, this.n * this.stride),
+      skipped: this.skipped,
+    };
+    this.n = 0;
+    this.skipped = 0;
+    return msg;
+  }
+}
+
+export class EngineSession {
+  private rt: Runtime | undefined;
+  private spec: PipelineSpec | undefined;
+  private loop: LoopHandle | undefined;
+  private state: EngineState = "empty";
+  private file = "";
+  private readonly watches = new Map<string, Watch>();
+
+  constructor(
+    private readonly catalog: Catalog,
+    private readonly platform: SessionPlatform,
+  ) {}
+
+  /** Handles one message from the UI (validated here). Never throws. */
+  async handle(raw: unknown): Promise<void> {
+    const parsed = parseUiMessage(raw);
+    if (!parsed.ok) {
+      const id = (raw as { id?: unknown } | null)?.id;
+      this.platform.post({
+        type: "reply",
+        id: typeof id === "number" ? id : -1,
+        ok: false,
+        message: parsed.error,
+      });
+      return;
+    }
+    const msg = parsed.msg;
+    try {
+      await this.dispatch(msg);
+    } catch (e) {
+      if ("id" in msg) this.reply(msg.id, false, errorMessage(e));
+    }
+  }
+
+  private reply(
+    id: number,
+    ok: boolean,
+    message?: string,
+    extra: Partial<EngineMessage> = {},
+  ): void {
+    this.platform.post({
+      type: "reply",
+      id,
+      ok,
+      ...(message !== undefined ? { message } : {}),
+      ...extra,
+    } as EngineMessage);
+  }
+
+  private setState(state: EngineState): void {
+    this.state = state;
+    this.platform.post({ type: "state", state, file: this.file });
+  }
+
+  private async dispatch(msg: UiMessage): Promise<void> {
+    switch (msg.type) {
+      case "hello":
+        this.platform.post({
+          type: "hello",
+          version: PROTOCOL_VERSION,
+          engine: this.platform.engine,
+          sharedMemory: this.platform.sharedMemory,
+        });
+        return;
+      case "load": {
+        const { diagnostics, graph } = await this.load(msg.file, msg.source);
+        const ok = graph !== undefined;
+        this.reply(msg.id, ok, ok ? undefined : "the pipeline has errors", {
+          diagnostics,
+          ...(graph ? { graph } : {}),
+        });
+        return;
+      }
+      case "start":
+        this.start();
+        this.reply(msg.id, true);
+        return;
+      case "stop":
+        this.stop();
+        this.reply(msg.id, true);
+        return;
+      case "setParam": {
+        const rt = this.requireRuntime();
+        this.reply(msg.id, true, rt.setParam(msg.block, msg.param, msg.value));
+        return;
+      }
+      case "invoke": {
+        const rt = this.requireRuntime();
+        const m = rt.invoke(msg.block, msg.action, msg.arg);
+        this.loop?.wake();
+        this.reply(msg.id, true, m);
+        return;
+      }
+      case "watch": {
+        const rt = this.requireRuntime();
+        const node = rt.node(msg.block);
+        if (!node) throw new Error(`no block '${msg.block}'`);
+        const port = msg.port ?? node.ports[0]?.name;
+        const p = node.ports.find((x) => x.name === port);
+        if (!p) throw new Error(`block '${msg.block}' has no output '${msg.port ?? "(default)"}'`);
+        const key = `${msg.block}.${p.name}`;
+        this.watches.get(key)?.untap();
+        const w = new Watch(
+          msg.block,
+          p.name,
+          p.shape.rows,
+          p.shape.cols,
+          node.desiredRate,
+          msg.maxRate ?? 500,
+        );
+        w.untap = rt.tap(msg.block, p.name, (f) => w.add(f));
+        this.watches.set(key, w);
+        this.reply(msg.id, true);
+        return;
+      }
+      case "unwatch": {
+        for (const [key, w] of this.watches) {
+          if (w.block === msg.block && (msg.port === undefined || w.port === msg.port)) {
+            w.untap();
+            this.watches.delete(key);
+          }
+        }
+        this.reply(msg.id, true);
+        return;
+      }
+    }
+  }
+
+  private requireRuntime(): Runtime {
+    if (!this.rt) throw new Error("no pipeline is loaded");
+    return this.rt;
+  }
+
+  private async load(
+    file: string,
+    source: string,
+  ): Promise<{ diagnostics: Diagnostic[]; graph?: GraphInfo }> {
+    this.unload();
+    this.file = file;
+    const loaded = loadPipeline(source, file, this.catalog);
+    if (!loaded.spec) {
+      this.setState("empty");
+      return { diagnostics: loaded.diagnostics };
+    }
+    const logs = this.platform.logs?.(file);
+    const created = await Runtime.create({
+      spec: loaded.spec,
+      catalog: this.catalog,
+      clock: this.platform.clock(),
+      virtual: false,
+      resources: this.platform.resources(file),
+      ...(logs ? { logs } : {}),
+      ignorePlacement: true,
+    });
+    const diagnostics = [...loaded.diagnostics, ...created.diagnostics];
+    if (!created.runtime) {
+      this.setState("empty");
+      return { diagnostics };
+    }
+    this.rt = created.runtime;
+    this.spec = loaded.spec;
+    this.setState("loaded");
+    return { diagnostics, graph: this.graph() };
+  }
+
+  private graph(): GraphInfo {
+    const rt = this.rt!;
+    const blocks: BlockInfo[] = this.spec!.blocks.map((b) => {
+      const node = rt.node(b.name)!;
+      let schema: unknown = {};
+      try {
+        schema = z.toJSONSchema(b.def.params, { io: "input", unrepresentable: "any" });
+      } catch {
+        schema = {};
+      }
+      const own = Object.entries(node.instance.actions ?? {}).map(([name, a]) => ({
+        name,
+        label: a.label,
+        ...(a.description !== undefined ? { description: a.description } : {}),
+      }));
+      return {
+        name: b.name,
+        type: b.type,
+        category: b.def.category,
+        summary: b.def.summary,
+        help: b.def.help,
+        worker: b.worker,
+        timer: b.def.timer === true,
+        desiredRate: node.desiredRate,
+        inputs: b.inputs.map((i) => ({
+          source: i.source,
+          block: i.block,
+          port: i.port,
+          subscribed: i.subscribed,
+        })),
+        outputs: node.ports.map((p) => ({ name: p.name, shape: p.shape })),
+        views: [...(b.def.views ?? [])],
+        panel: b.def.panel ?? "",
+        live: [...(b.def.live ?? [])],
+        params: (node.params ?? {}) as Record<string, unknown>,
+        paramsSchema: schema,
+        actions: [...own, ...BUILT_IN_ACTIONS],
+        ...(b.layout ? { layout: b.layout } : {}),
+        ...(b.path !== undefined ? { path: b.path } : {}),
+      };
+    });
+    return { file: this.file, blocks };
+  }
+
+  private start(): void {
+    const rt = this.requireRuntime();
+    if (this.state === "running") return;
+    rt.start();
+    this.loop = this.platform.startLoop(rt, {
+      telemetryIntervalS: 0.05,
+      onTelemetry: () => this.flush(),
+      onFinished: () => {
+        this.flush();
+        this.setState("finished");
+      },
+    });
+    rt.onWake = () => this.loop?.wake();
+    this.setState("running");
+  }
+
+  /** Sends telemetry, events and the panel data gathered since the previous flush. */
+  private flush(): void {
+    const rt = this.rt;
+    if (!rt) return;
+    const telemetry = rt.telemetry();
+    const events = telemetry.events;
+    telemetry.events = [];
+    this.platform.post({ type: "telemetry", telemetry });
+    for (const event of events) this.platform.post({ type: "event", event });
+    for (const w of this.watches.values()) {
+      const m = w.take();
+      if (m && m.type === "data")
+        this.platform.post(m, [m.t.buffer as ArrayBuffer, m.v.buffer as ArrayBuffer]);
+    }
+  }
+
+  private stop(): void {
+    if (!this.rt || this.state !== "running") return;
+    this.loop?.stop();
+    this.loop = undefined;
+    this.rt.stop();
+    this.rt.dispatch();
+    this.flush();
+    this.setState("stopped");
+  }
+
+  private unload(): void {
+    this.stop();
+    for (const w of this.watches.values()) w.untap();
+    this.watches.clear();
+    this.rt?.dispose();
+    this.rt = undefined;
+    this.spec = undefined;
+  }
+
+  dispose(): void {
+    this.unload();
+  }
+}

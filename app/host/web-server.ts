@@ -1,0 +1,89 @@
+/**
+ * A small static file server for the browser build (dist/web), used by `npm start` and
+ * `mosaic web`. Binds 127.0.0.1 by default and sends the cross-origin isolation headers, so the
+ * engine worker gets shared memory and the precise real-time loop.
+ */
+import { createReadStream, existsSync, statSync } from "node:fs";
+import { createServer, type Server } from "node:http";
+import { extname, join, normalize, resolve, sep } from "node:path";
+
+const TYPES: Record<string, string> = {
+  ".html": "text/html; charset=utf-8",
+  ".js": "text/javascript; charset=utf-8",
+  ".mjs": "text/javascript; charset=utf-8",
+  ".css": "text/css; charset=utf-8",
+  ".json": "application/json; charset=utf-8",
+  ".map": "application/json; charset=utf-8",
+  ".wasm": "application/wasm",
+  ".yaml": "text/yaml; charset=utf-8",
+  ".csv": "text/csv; charset=utf-8",
+  ".txt": "text/plain; charset=utf-8",
+  ".md": "text/markdown; charset=utf-8",
+  ".svg": "image/svg+xml",
+  ".png": "image/png",
+};
+
+export interface WebServer {
+  server: Server;
+  url: string;
+  close(): Promise<void>;
+}
+
+/** Serves `root` on host:port (port 0 picks a free one). Rejects when the port is taken. */
+export function serveStatic(root: string, port: number, host = "127.0.0.1"): Promise<WebServer> {
+  const base = resolve(root);
+  const server = createServer((req, res) => {
+    const headers = {
+      "Cross-Origin-Opener-Policy": "same-origin",
+      "Cross-Origin-Embedder-Policy": "require-corp",
+      "Cross-Origin-Resource-Policy": "same-origin",
+      "X-Content-Type-Options": "nosniff",
+      "Cache-Control": "no-cache",
+    };
+    if (req.method !== "GET" && req.method !== "HEAD") {
+      res.writeHead(405, headers).end();
+      return;
+    }
+    let path: string;
+    try {
+      path = decodeURIComponent(new URL(req.url ?? "/", "http://localhost").pathname);
+    } catch {
+      res.writeHead(400, headers).end("bad request");
+      return;
+    }
+    const file = normalize(join(base, path.endsWith("/") ? path + "index.html" : path));
+    if (file !== base && !file.startsWith(base + sep)) {
+      res.writeHead(403, headers).end("forbidden");
+      return;
+    }
+    if (!existsSync(file) || !statSync(file).isFile()) {
+      res.writeHead(404, { ...headers, "Content-Type": "text/plain" }).end("not found");
+      return;
+    }
+    res.writeHead(200, {
+      ...headers,
+      "Content-Type": TYPES[extname(file).toLowerCase()] ?? "application/octet-stream",
+      "Content-Length": statSync(file).size,
+    });
+    if (req.method === "HEAD") res.end();
+    else createReadStream(file).pipe(res);
+  });
+  return new Promise((resolvePromise, reject) => {
+    server.once("error", (e: NodeJS.ErrnoException) => {
+      reject(
+        e.code === "EADDRINUSE"
+          ? new Error(`port ${port} on ${host} is already in use: pick another with --port N`)
+          : e,
+      );
+    });
+    server.listen(port, host, () => {
+      const addr = server.address();
+      const p = typeof addr === "object" && addr ? addr.port : port;
+      resolvePromise({
+        server,
+        url: `http://${host === "0.0.0.0" ? "127.0.0.1" : host}:${p}/`,
+        close: () => new Promise((r) => server.close(() => r())),
+      });
+    });
+  });
+}

@@ -1,0 +1,158 @@
+/**
+ * The UI's handle on an engine (any transport): request/reply with promises, the latest
+ * telemetry, and panel data streams shared between the panels that watch the same output.
+ * Framework-free; React components use it through the hooks in ./hooks.ts.
+ */
+import type {
+  DataMessage,
+  EngineConnection,
+  EngineMessage,
+  EngineState,
+  GraphInfo,
+  UiMessage,
+} from "../../engine/protocol";
+import type { Diagnostic } from "../../engine/diagnostics";
+import type { RuntimeEvent, Telemetry } from "../../engine/runtime/runtime";
+
+type Request = UiMessage extends infer M
+  ? M extends { id: number }
+    ? Omit<M, "id">
+    : never
+  : never;
+
+export interface Reply {
+  ok: boolean;
+  message?: string;
+  diagnostics?: Diagnostic[];
+  graph?: GraphInfo;
+}
+
+export type DataListener = (m: DataMessage) => void;
+
+export class EngineClient {
+  private nextId = 1;
+  private readonly pending = new Map<number, (r: Reply) => void>();
+  private readonly telemetryListeners = new Set<(t: Telemetry) => void>();
+  private readonly eventListeners = new Set<(e: RuntimeEvent) => void>();
+  private readonly stateListeners = new Set<(s: EngineState) => void>();
+  private readonly dataListeners = new Map<string, Set<DataListener>>();
+  private readonly off: () => void;
+  telemetry: Telemetry | undefined;
+  state: EngineState = "empty";
+  graph: GraphInfo | undefined;
+  engineName = "";
+  sharedMemory = false;
+
+  constructor(readonly connection: EngineConnection) {
+    this.off = connection.onMessage((m) => this.receive(m));
+    connection.send({ type: "hello", version: 1 });
+  }
+
+  private receive(m: EngineMessage): void {
+    switch (m.type) {
+      case "hello":
+        this.engineName = m.engine;
+        this.sharedMemory = m.sharedMemory;
+        break;
+      case "reply": {
+        const r = this.pending.get(m.id);
+        this.pending.delete(m.id);
+        r?.(m);
+        break;
+      }
+      case "state":
+        this.state = m.state;
+        for (const l of this.stateListeners) l(m.state);
+        break;
+      case "telemetry":
+        this.telemetry = m.telemetry;
+        for (const l of this.telemetryListeners) l(m.telemetry);
+        break;
+      case "event":
+        for (const l of this.eventListeners) l(m.event);
+        break;
+      case "data":
+        for (const l of this.dataListeners.get(`${m.block}.${m.port}`) ?? []) l(m);
+        break;
+    }
+  }
+
+  /** Sends a request and resolves with the engine's reply (never rejects). */
+  request(msg: Request): Promise<Reply> {
+    const id = this.nextId++;
+    return new Promise((resolve) => {
+      this.pending.set(id, resolve);
+      this.connection.send({ ...msg, id } as UiMessage);
+    });
+  }
+
+  async load(file: string, source: string): Promise<Reply> {
+    const r = await this.request({ type: "load", file, source });
+    this.graph = r.graph;
+    return r;
+  }
+
+  start(): Promise<Reply> {
+    return this.request({ type: "start" });
+  }
+
+  stop(): Promise<Reply> {
+    return this.request({ type: "stop" });
+  }
+
+  setParam(block: string, param: string, value: unknown): Promise<Reply> {
+    return this.request({ type: "setParam", block, param, value });
+  }
+
+  invoke(block: string, action: string, arg?: unknown): Promise<Reply> {
+    return this.request({ type: "invoke", block, action, ...(arg !== undefined ? { arg } : {}) });
+  }
+
+  onTelemetry(l: (t: Telemetry) => void): () => void {
+    this.telemetryListeners.add(l);
+    return () => this.telemetryListeners.delete(l);
+  }
+
+  onEvent(l: (e: RuntimeEvent) => void): () => void {
+    this.eventListeners.add(l);
+    return () => this.eventListeners.delete(l);
+  }
+
+  onState(l: (s: EngineState) => void): () => void {
+    this.stateListeners.add(l);
+    return () => this.stateListeners.delete(l);
+  }
+
+  /**
+   * Streams a block output's data (panel open). Several listeners share one engine watch; the
+   * engine stops sending when the last one leaves. Returns the unsubscribe function.
+   */
+  watch(block: string, port: string | undefined, l: DataListener, maxRate = 500): () => void {
+    const key = `${block}.${port ?? this.defaultPort(block)}`;
+    let set = this.dataListeners.get(key);
+    if (!set) {
+      set = new Set();
+      this.dataListeners.set(key, set);
+      void this.request({ type: "watch", block, ...(port !== undefined ? { port } : {}), maxRate });
+    }
+    set.add(l);
+    return () => {
+      const s = this.dataListeners.get(key);
+      if (!s) return;
+      s.delete(l);
+      if (s.size === 0) {
+        this.dataListeners.delete(key);
+        void this.request({ type: "unwatch", block, ...(port !== undefined ? { port } : {}) });
+      }
+    };
+  }
+
+  private defaultPort(block: string): string {
+    return this.graph?.blocks.find((b) => b.name === block)?.outputs[0]?.name ?? "out";
+  }
+
+  close(): void {
+    this.off();
+    this.connection.close();
+  }
+}

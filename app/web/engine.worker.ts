@@ -1,0 +1,108 @@
+/**
+ * The browser build's engine: a dedicated Web Worker running one EngineSession (the whole
+ * pipeline) with the WASM core. The page talks to it with the UI protocol (postMessage).
+ * Cross-origin isolated pages get the precise loop (shared memory + Atomics.wait); others fall
+ * back to timers (less precise ticks, shown as lagging when the browser cannot keep up).
+ */
+/// <reference lib="webworker" />
+import { catalog } from "../blocks/catalog";
+import type { Resources } from "../engine/block";
+import { MonotonicClock } from "../engine/clock";
+import { initDsp } from "../engine/dsp";
+import type { EngineMessage } from "../engine/protocol";
+import { CoarseLoop } from "../engine/runtime/coarse-loop";
+import { RealtimeLoop } from "../engine/runtime/loop";
+import { EngineSession, type LoopHooks, type SessionPlatform } from "../engine/session";
+import type { Runtime } from "../engine/runtime/runtime";
+
+declare const self: DedicatedWorkerGlobalScope;
+
+const shared = typeof SharedArrayBuffer === "function" && self.crossOriginIsolated === true;
+
+/** A turn of the event loop without the 4 ms clamping of nested timeouts. */
+const channel = new MessageChannel();
+const queue: (() => void)[] = [];
+channel.port1.onmessage = () => {
+  const fn = queue.shift();
+  fn?.();
+};
+const yieldNow = (fn: () => void): void => {
+  queue.push(fn);
+  channel.port2.postMessage(0);
+};
+
+/** Files are fetched relative to the pipeline file's URL (pipelines and their data are static). */
+function fetchResources(file: string): Resources {
+  const base = new URL(file, self.location.href);
+  const resolve = (p: string): string => new URL(p, base).href;
+  return {
+    resolve,
+    async readText(p: string) {
+      const url = resolve(p);
+      const r = await fetch(url);
+      if (!r.ok) throw new Error(`cannot read ${url}: HTTP ${r.status}`);
+      return r.text();
+    },
+    writeText(p: string) {
+      return Promise.reject(new Error(`the browser build cannot write files (asked for '${p}')`));
+    },
+  };
+}
+
+function startLoop(rt: Runtime, hooks: LoopHooks) {
+  if (shared) {
+    const loop = new RealtimeLoop({
+      runtime: rt,
+      yieldNow,
+      clock: rt.clock,
+      doorbell: new Int32Array(new SharedArrayBuffer(8)),
+      precision: false,
+      ...hooks,
+    });
+    loop.start();
+    return loop;
+  }
+  const loop = new CoarseLoop({
+    runtime: rt,
+    clock: rt.clock,
+    sleep: (fn, ms) => setTimeout(fn, ms),
+    yieldNow,
+    ...hooks,
+  });
+  loop.start();
+  return loop;
+}
+
+const platform: SessionPlatform = {
+  engine: shared
+    ? "browser worker (shared memory)"
+    : "browser worker (no shared memory: coarse timing)",
+  sharedMemory: shared,
+  clock: () => new MonotonicClock(),
+  resources: fetchResources,
+  startLoop,
+  post: (msg: EngineMessage, transfer?: ArrayBuffer[]) => self.postMessage(msg, transfer ?? []),
+};
+
+let session: EngineSession | undefined;
+const pending: unknown[] = [];
+
+async function boot(): Promise<void> {
+  const r = await fetch(new URL("mosaic_core_bg.wasm", self.location.href));
+  if (!r.ok) throw new Error(`cannot load the DSP core: HTTP ${r.status}`);
+  initDsp(await r.arrayBuffer());
+  session = new EngineSession(catalog, platform);
+  for (const m of pending.splice(0)) await session.handle(m);
+}
+
+self.onmessage = (e: MessageEvent) => {
+  if (session) void session.handle(e.data);
+  else pending.push(e.data);
+};
+
+boot().catch((e: unknown) => {
+  self.postMessage({
+    type: "event",
+    event: { t: Date.now() / 1000, level: "error", block: "engine", message: String(e) },
+  });
+});
