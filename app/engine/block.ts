@@ -8,6 +8,7 @@
  */
 import type { z } from "zod";
 import type { Frame, Shape } from "./frame";
+import type { IoBridges } from "./io";
 import type { LogChannel } from "./runtime/logsink";
 
 export type BlockCategory =
@@ -102,6 +103,8 @@ export interface BlockContext {
   /** True under the virtual clock (as fast as possible, deterministic). */
   readonly virtual: boolean;
   readonly resources: Resources;
+  /** Device and network I/O provided by the host (empty in the browser build). */
+  readonly io: IoBridges;
   /** Declares an output port (the first declared port is the default one). */
   output(shape: Shape, port?: string): OutputPort;
   /** A periodic callback on the high-resolution scheduler; missed ticks are skipped and counted. */

@@ -4,6 +4,7 @@ export * from "./catalog";
 export * from "./clock";
 export * from "./diagnostics";
 export * from "./frame";
+export * from "./io";
 export * from "./suggest";
 export * from "./pipeline/legacy";
 export * from "./pipeline/loader";

@@ -12,6 +12,7 @@ import type {
   TimerHandle,
 } from "./block";
 import type { Catalog } from "./catalog";
+import type { IoBridges } from "./io";
 import { VirtualClock } from "./clock";
 import { formatDiagnostic, type Diagnostic } from "./diagnostics";
 import { Frame, FramePool, type Shape } from "./frame";
@@ -112,6 +113,7 @@ export interface HarnessOptions {
   desiredRate?: number;
   now?: number;
   resources?: Resources;
+  io?: IoBridges;
   virtual?: boolean;
 }
 
@@ -186,6 +188,7 @@ export class BlockHarness {
       startTime: this.opts.now ?? 0,
       virtual: this.opts.virtual ?? true,
       resources: this.opts.resources ?? noResources,
+      io: this.opts.io ?? {},
       output(shape: Shape, port?: string): OutputPort {
         const name = port ?? "out";
         const pool = new FramePool(shape);

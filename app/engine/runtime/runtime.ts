@@ -21,6 +21,7 @@ import { BlockConfigError, errorMessage, type Diagnostic } from "../diagnostics"
 import { Frame, FramePool, formatShape, type Shape } from "../frame";
 import type { BlockSpec, PipelineSpec, QueuePolicy, SourcePos } from "../pipeline/loader";
 import type { Clock } from "../clock";
+import type { IoBridges } from "../io";
 import { Deque } from "./deque";
 import type { LogChannel, LogSink } from "./logsink";
 import type { SabRing } from "./sab-ring";
@@ -129,6 +130,8 @@ export interface RuntimeOptions {
   clock: Clock;
   virtual: boolean;
   resources: Resources;
+  /** Device and network bridges (Node host); none in browsers. */
+  io?: IoBridges;
   logs?: LogSink;
   /** Name of this worker ("main" by default); blocks placed elsewhere are not instantiated. */
   worker?: string;
@@ -304,6 +307,7 @@ export class Runtime {
   private readonly events: RuntimeEvent[] = [];
   private readonly logs: LogSink | undefined;
   private readonly resources: Resources;
+  private readonly io: IoBridges;
   startTime = NaN;
   running = false;
   private finiteCount = 0;
@@ -321,6 +325,7 @@ export class Runtime {
     this.scheduler = new Scheduler(opts.virtual);
     this.logs = opts.logs;
     this.resources = opts.resources;
+    this.io = opts.io ?? {};
   }
 
   /**
@@ -516,6 +521,7 @@ export class Runtime {
       },
       virtual: this.virtual,
       resources: this.resources,
+      io: this.io,
       output(shape: Shape, port?: string): OutputPort {
         const name = port ?? node.spec.outputs[node.ports.length] ?? "out";
         if (node.ports.some((p) => p.name === name)) {
@@ -610,6 +616,8 @@ export class Runtime {
       if (f.refs === 0) f.pool?.release(f);
       return;
     }
+    // Emitted from an I/O callback (a datagram, serial bytes): wake the loop to deliver it now.
+    if (!this.stepping && this.running) this.onWake?.();
     const now = this.clock.now();
     // Status follows the default (first) output; other ports emit in step with it.
     if (port === port.node.ports[0]) port.node.status.record(f, now);
@@ -720,10 +728,18 @@ export class Runtime {
 
   /** One step of the loop: take in frames from other workers, fire due timers, deliver. */
   step(now: number): void {
-    if (this.inbound.length > 0) this.drainInbound();
-    this.fireDue(now);
-    this.dispatch();
+    this.stepping = true;
+    try {
+      if (this.inbound.length > 0) this.drainInbound();
+      this.fireDue(now);
+      this.dispatch();
+    } finally {
+      this.stepping = false;
+    }
   }
+
+  /** True while the loop runs a step (emits then are dispatched in that step). */
+  private stepping = false;
 
   private readonly inbound: Edge[] = [];
 
