@@ -18,6 +18,8 @@ GENERATORS=(
   "core-wasm/dsp/tests/fixtures/gen_window.py:window.json"
   "core-wasm/dsp/tests/fixtures/gen_adaptive.py:adaptive.json"
   "core-wasm/dsp/tests/fixtures/gen_artifact.py:artifact.json"
+  "core-wasm/learn/tests/fixtures/gen_learn.py:learn.json"
+  "core-wasm/learn/tests/fixtures/gen_emg_regression.py:emg_regression.json"
 )
 
 # uv as installed by scripts/setup.sh (pip --user: `python3 -m uv`), or on PATH.
@@ -44,7 +46,7 @@ trap 'rm -rf "$TMP"' EXIT
 run_py() {
   PYTHONDONTWRITEBYTECODE=1 UV_PYTHON_DOWNLOADS=never "${UV[@]}" run --frozen --quiet --project "$PROJECT" --python python3.11 python "$@"
 }
-if ! run_py -c "import numpy, scipy" 2>"$TMP/setup.log"; then
+if ! run_py -c "import numpy, scipy, sklearn" 2>"$TMP/setup.log"; then
   cat "$TMP/setup.log" >&2
   echo "check-fixtures: error: cannot set up the reference environment (tests/reference); see above." >&2
   exit 2

@@ -24,6 +24,8 @@ import { SlidingWindow } from "./flow/sliding-window";
 import { Splitter } from "./flow/splitter";
 import { Switch } from "./flow/switch";
 import { VectorialFunction } from "./flow/vectorial-function";
+import { BatchPredictor } from "./learning/batch-predictor";
+import { IncrementalPredictor } from "./learning/incremental-predictor";
 import { Stimulus } from "./learning/stimulus";
 import { TAC } from "./learning/tac";
 import { Trigger } from "./learning/trigger";
@@ -84,6 +86,8 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   Trigger,
   Stimulus,
   TAC,
+  BatchPredictor,
+  IncrementalPredictor,
   // Control
   ControlAlgorithm,
   // Recording

@@ -314,6 +314,75 @@ const SETUPS: Record<string, Setup | Setup[]> = {
         port === 1 ? (i % 22 === 0 ? [0.5, 0] : [NaN, NaN]) : smooth(i, port, size),
     },
   ],
+  IncrementalPredictor: [
+    {
+      params: { Lambda: 0.1 },
+      inputs: [vec(3), vec(2, 10)],
+      pattern: [1, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0],
+      // Targets, with an all-NaN stop every 10th event.
+      values: (i, port, size) =>
+        port === 1 ? (i % 10 === 0 ? [NaN, NaN] : [Math.sin(i), 1]) : smooth(i, port, size),
+    },
+    {
+      params: {
+        Model: "rff",
+        Features: 16,
+        Gamma: 0.2,
+        Normalize: true,
+        NormalizeSamples: 5,
+        Forgetting: 0.95,
+      },
+      inputs: [vec(4), vec(1, 10)],
+      pattern: [1, 0, 0, 0, 1, 0, 0],
+      values: (i, port, size) =>
+        port === 1 ? (i % 14 === 4 ? [NaN] : [i / 10]) : smooth(i, port, size),
+    },
+    {
+      // Predicting only, with a model file: one sample x = (1, 2), y = 3, λ 1, no intercept.
+      params: { File: "m.json" },
+      inputs: [vec(2)],
+      resources: memoryResources({
+        "m.json": JSON.stringify({
+          format: "mosaic-model",
+          version: 1,
+          kind: "ridge",
+          inputs: 2,
+          outputs: 1,
+          lambda: 1,
+          forgetting: 1,
+          intercept: false,
+          normalize: false,
+          samplesSeen: 1,
+          lambdaEffective: 1,
+          model: { weights: [[0.5], [1]], intercept: [0], penalty: [1, 1] },
+          state: {
+            weightSum: 1,
+            xMean: [0, 0],
+            yMean: [0],
+            scatter: [
+              [1, 2],
+              [2, 4],
+            ],
+            cross: [[3], [6]],
+            fitStats: { weight: 0, mean: [0], m2: [0], sse: [0] },
+          },
+        }),
+      }),
+    },
+  ],
+  BatchPredictor: [
+    {
+      // Dataset replace: a frame of rows is a data set, so rows come one frame each here.
+      params: { Lambda: 0.5 },
+      inputs: [vec(2), vec(3, 5)],
+      pattern: [1, 0, 0, 0, 1, 0, 0],
+    },
+    {
+      params: { Model: "rff", Features: 8, Dataset: "append", AutoTrain: false },
+      inputs: [vec(2), vec(4, 5)],
+      pattern: [1, 1, 0, 0, 1, 0],
+    },
+  ],
   Busy: {
     params: { Milliseconds: 0, Every: 3 },
     inputs: [vec(2)],

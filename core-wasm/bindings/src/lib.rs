@@ -9,8 +9,12 @@
 //! `ensure_capacity` may move the buffers (and grow the memory), so the
 //! pointers and views must be fetched again after it.
 //!
-//! The names of the exports are a contract with `app/engine/dsp/index.ts`.
+//! The names of the exports are a contract with `app/engine/dsp/index.ts`
+//! (and `app/engine/dsp/learn.ts` for [`WasmLearner`], in `learn.rs`).
 #![warn(missing_docs)]
+
+mod learn;
+pub use learn::WasmLearner;
 
 use mosaic_dsp::{
     AdaptiveFilter, AdaptiveFilterConfig, ArtifactConfig, ArtifactRejector, DerivativeOrder,

@@ -1,0 +1,438 @@
+import { z } from "zod";
+import {
+  BlockConfigError,
+  defineBlock,
+  errorMessage,
+  LegacyParamsError,
+  vectorShape,
+  type Frame,
+} from "../../engine";
+import type { LearningModel, ResolvedLearningOptions } from "../../engine/dsp";
+import { requireDsp } from "../shared/dsp";
+import { inputName, signalInput } from "../shared/inputs";
+import { formatCount, plural } from "../shared/text";
+import {
+  createModel,
+  describeOptions,
+  formatR2,
+  isMissingFile,
+  legacyMachine,
+  listR2,
+  loadModel,
+  MODEL_HELP,
+  modelParams,
+  ModelFileError,
+  optionsFromParams,
+  serializeModel,
+} from "./model-file";
+
+/** MOSAIC's batch learning machines (Learning.cs). */
+const MACHINES = ["RidgeRegression", "RR_RFF"] as const;
+/** Most values the row store may hold (1 GiB of doubles). */
+const MAX_VALUES = 2 ** 27;
+
+const params = z.strictObject({
+  ...modelParams,
+  Dataset: z
+    .enum(["replace", "append"])
+    .default("replace")
+    .describe(
+      "replace: every frame on the pairs input is a whole data set (the Buffer's emit sends all " +
+        "its rows in one frame) and replaces the rows received before; append: rows accumulate " +
+        "(a Buffer with Stream: true), until clear",
+    ),
+  AutoTrain: z
+    .boolean()
+    .default(true)
+    .describe(
+      "Fit as soon as rows arrive (each fit uses every row kept); false: fit on the train action",
+    ),
+  MaxRows: z
+    .number()
+    .int()
+    .min(1)
+    .max(10_000_000)
+    .default(100_000)
+    .describe("Most rows kept (rows beyond are dropped and counted)"),
+  Buffer: z
+    .string()
+    .min(1)
+    .optional()
+    .describe(
+      "MOSAIC's form named the Buffer in Params; here the Buffer's pairs output is the second " +
+        "input (this name is only checked against it)",
+    ),
+});
+
+export const BatchPredictor = defineBlock({
+  type: "BatchPredictor",
+  category: "Learning",
+  summary: "Fits a regression model in one go on Buffer rows (target, data), then predicts.",
+  help:
+    "Batch learning (paper III-G): inputs are `[features, pairs]`. The pairs input carries rows " +
+    "[target (M values), data (d values)] — the Buffer block's `pairs` output, whose `emit` " +
+    "action sends every stored row in one frame; d is the width of the features input, and M " +
+    "the rest. With `Dataset: replace` (default) each frame of rows is a whole data set and " +
+    "replaces the previous one (so, unlike other inputs, it matters how rows are grouped in " +
+    "frames); with `append` rows accumulate. With `AutoTrain` the model is fitted as soon as rows " +
+    "arrive; otherwise on the `train` action. A fit forgets the previous model and solves the " +
+    "normal equations of all rows at once. Every event of the features input gives a prediction " +
+    "[1, M] (zeros before the first fit). The `fit` output carries, for every fit, [rows used, " +
+    "R² of each output], the in-sample R² of the fitted rows. " +
+    MODEL_HELP +
+    " A `File` that exists is loaded when the pipeline is created and replaces the model the " +
+    "params describe. Actions: `train` (fit on the rows kept), `clear` (drop the rows), `reset` " +
+    "(forget the model), `save` and `load` (a file name, default File or <block>.model.json) and " +
+    "`inspect`. MOSAIC's `[buffer, RR_RFF, 8, 12, λ, σ, D]` loads as the same model (γ = σ²/2, " +
+    "λ·2/D, no intercept); its Buffer must then be written as the second input.",
+  params,
+  legacyParams: (args) => {
+    if (args.length < 2) {
+      throw new LegacyParamsError(
+        "expected [buffer, machine, inputs, outputs, …], e.g. [cluster_storage, RidgeRegression, 8, 12]",
+        "Buffer",
+      );
+    }
+    return {
+      Buffer: args[0]!.trim(),
+      ...legacyMachine(args[1]!.trim(), args.slice(2, 4), args.slice(4), MACHINES),
+    };
+  },
+  legacyForm:
+    "[buffer, RidgeRegression, d, M, λ?] or [buffer, RR_RFF, d, M, λ?, σ?, D?] (MOSAIC's " +
+    "Buffer name, machine, sizes and hyper-parameters)",
+  inputs: { min: 1, max: 2, labels: ["features", "pairs"] },
+  outputs: ["prediction", "fit"],
+  views: ["scope", "spider", "label"],
+  panel:
+    "Predictions (scope, spider), rows kept and the R² of the last fit; train, clear, reset, " +
+    "save, load and inspect buttons.",
+  async create(ctx, p) {
+    requireDsp("BatchPredictor");
+    const feat = signalInput(ctx, 0, "Inputs");
+    const d = feat.size;
+    if (p.Inputs !== undefined && p.Inputs !== d) {
+      throw new BlockConfigError(
+        `Inputs is ${p.Inputs} but the features input ${inputName(feat.info)} carries ${d} values ` +
+          "per event",
+        "Inputs",
+      );
+    }
+    const pairsIn = ctx.inputs.length > 1 ? signalInput(ctx, 1) : null;
+    if (!pairsIn && p.Buffer !== undefined) {
+      throw new BlockConfigError(
+        `MOSAIC's BatchPredictor read the Buffer '${p.Buffer}' directly; here its rows arrive on a ` +
+          `second input: write \`Inputs: [${feat.info.source}, ${p.Buffer}]\` (then the Buffer's ` +
+          "emit action trains the model)",
+        "Buffer",
+      );
+    }
+    if (pairsIn && p.Buffer !== undefined && pairsIn.info.block !== p.Buffer) {
+      ctx.warn(
+        `Buffer is '${p.Buffer}' but the pairs input is ${inputName(pairsIn.info)}; using the input`,
+      );
+    }
+    let m: number | null = null;
+    if (pairsIn) {
+      m = pairsIn.size - d;
+      if (m < 1) {
+        throw new BlockConfigError(
+          `the pairs input ${inputName(pairsIn.info)} carries ${pairsIn.size} values per event; ` +
+            `rows must be [target…, data…] with the ${d} data values of ` +
+            `${inputName(feat.info)} and at least one target value`,
+          "Outputs",
+        );
+      }
+      if (p.Outputs !== undefined && p.Outputs !== m) {
+        throw new BlockConfigError(
+          `Outputs is ${p.Outputs} but the pairs input ${inputName(pairsIn.info)} carries ` +
+            `${pairsIn.size} values per row, ${d} of them data: ${m} targets`,
+          "Outputs",
+        );
+      }
+    } else {
+      m = p.Outputs ?? null;
+    }
+    const W = d + (m ?? 0);
+    const defaultFile = p.File ?? `${ctx.name}.model.json`;
+
+    let loaded: { model: LearningModel; state: Float64Array } | null = null;
+    let note = "";
+    if (p.File !== undefined) {
+      let text: string | null = null;
+      try {
+        text = await ctx.resources.readText(p.File);
+      } catch (e) {
+        if (!isMissingFile(e)) {
+          throw new BlockConfigError(
+            `cannot read model file '${p.File}': ${errorMessage(e)}`,
+            "File",
+          );
+        }
+        note = ` (no ${p.File} yet)`;
+      }
+      if (text !== null) {
+        try {
+          const r = loadModel(text, p.File, {
+            inputs: d,
+            outputs: m,
+            inputName: feat.info.source,
+            targetName: null,
+          });
+          loaded = { model: r.model, state: r.file.state };
+          m = r.file.options.outputs;
+          note = ` (loaded ${p.File})`;
+        } catch (e) {
+          if (e instanceof ModelFileError) throw new BlockConfigError(e.message, "File");
+          throw e;
+        }
+      }
+    }
+    if (m === null) {
+      throw new BlockConfigError(
+        "BatchPredictor needs a pairs input (its second input), Outputs, or an existing File to " +
+          "know how many values it predicts",
+        "Outputs",
+      );
+    }
+    const M = m;
+    const maxRows = p.MaxRows;
+    if (pairsIn && maxRows * W > MAX_VALUES) {
+      throw new BlockConfigError(
+        `MaxRows ${formatCount(maxRows)} rows of ${W} values would take up to ` +
+          `${((maxRows * W * 8) / 2 ** 30).toFixed(1)} GiB; at most ${formatCount(MAX_VALUES)} ` +
+          `values (1 GiB) are kept: set MaxRows to ${formatCount(Math.floor(MAX_VALUES / W))} or less`,
+        "MaxRows",
+      );
+    }
+    const created: ResolvedLearningOptions = loaded
+      ? loaded.model.options
+      : optionsFromParams(p, d, M);
+    let model: LearningModel = loaded ? loaded.model : createModel(created);
+    const initialState = loaded?.state ?? null;
+    let replaced = false;
+
+    const out = ctx.output(vectorShape(M), "prediction");
+    const fitOut = ctx.output(vectorShape(1 + M), "fit");
+
+    let values = new Float64Array(Math.min(maxRows, 256) * W);
+    let rows = 0;
+    let dropped = 0;
+    let fittedRows = -1; // rows of the last fit; -1: none since creation/reset/load
+    let disposed = false;
+    let lastSaved = "";
+    const r2 = new Float64Array(M);
+
+    const describe = (): void => {
+      let s: string;
+      if (fittedRows >= 0 && fittedRows === rows) {
+        model.r2(r2);
+        s = `fitted on ${plural(model.samplesSeen(), "row")}, ${formatR2(r2)}`;
+      } else if (rows > 0) {
+        s =
+          `${plural(rows, "row")} kept` + (fittedRows >= 0 ? "; fitted before on other rows" : "");
+        s += p.AutoTrain ? "" : " (press train)";
+      } else if (model.samplesSeen() > 0) {
+        model.r2(r2);
+        s = `trained on ${plural(model.samplesSeen(), "row")}, ${formatR2(r2)}; no rows kept`;
+      } else {
+        s = "untrained: no rows yet";
+      }
+      if (dropped > 0) s += `; ${formatCount(dropped)} rows dropped (MaxRows)`;
+      ctx.setText(s + (lastSaved !== "" ? ` (${lastSaved})` : note));
+    };
+    describe();
+
+    const grow = (need: number): void => {
+      let cap = values.length / W;
+      if (need <= cap) return;
+      while (cap < need) cap *= 2;
+      cap = Math.min(cap, maxRows);
+      const v = new Float64Array(cap * W);
+      v.set(values.subarray(0, rows * W));
+      values = v;
+    };
+
+    const fit = (t: number): string => {
+      if (rows === 0) return "no rows to fit";
+      const used = model.fitPairs(values, rows);
+      fittedRows = rows;
+      model.r2(r2);
+      const fo = fitOut.frame(1);
+      fo.t[0] = t;
+      fo.v[0] = used;
+      for (let i = 0; i < M; i++) fo.v[1 + i] = r2[i]!;
+      fitOut.emit(fo);
+      describe();
+      const refused = rows - used;
+      return (
+        `fitted ${describeOptions(model.options)} on ${plural(used, "row")}` +
+        (refused > 0 ? ` (${formatCount(refused)} refused)` : "") +
+        `, in-sample ${formatR2(r2)}`
+      );
+    };
+
+    let warnedFull = false;
+    const onRows = (f: Frame): void => {
+      const n = f.n;
+      if (p.Dataset === "replace") {
+        rows = 0;
+        dropped = 0;
+        warnedFull = false;
+      }
+      const take = Math.min(n, maxRows - rows);
+      if (take < n) {
+        dropped += n - take;
+        if (!warnedFull) {
+          warnedFull = true;
+          ctx.warn(
+            `more rows than MaxRows (${formatCount(maxRows)}): ${formatCount(n - take)} dropped`,
+          );
+        }
+      }
+      if (take > 0) {
+        grow(rows + take);
+        const v = f.v;
+        const at = rows * W;
+        for (let i = 0; i < take * W; i++) values[at + i] = v[i]!;
+        rows += take;
+      }
+      if (p.AutoTrain) fit(f.t[n - 1]!);
+      else describe();
+    };
+
+    const onFeatures = (f: Frame): void => {
+      const n = f.n;
+      const o = out.frame(n);
+      const ft = f.t;
+      for (let e = 0; e < n; e++) o.t[e] = ft[e]!;
+      model.predict(f.v, o.v, n);
+      out.emit(o);
+    };
+
+    const fileArg = (arg: unknown): string =>
+      typeof arg === "string" && arg.trim() !== "" ? arg.trim() : defaultFile;
+
+    return {
+      process(f, port) {
+        if (f.n === 0) return;
+        if (port === 1) onRows(f);
+        else onFeatures(f);
+      },
+      reset() {
+        if (replaced) {
+          model.dispose();
+          model = createModel(created);
+          replaced = false;
+        }
+        if (initialState) model.loadState(initialState);
+        else model.reset();
+        rows = 0;
+        dropped = 0;
+        warnedFull = false;
+        fittedRows = -1;
+        lastSaved = "";
+        describe();
+      },
+      dispose() {
+        if (disposed) return;
+        disposed = true;
+        model.dispose();
+      },
+      actions: {
+        train: {
+          label: "Train",
+          description: "Fit the model on every row kept",
+          run() {
+            return fit(ctx.now());
+          },
+        },
+        clear: {
+          label: "Clear rows",
+          description: "Drop the rows kept (the model stays)",
+          run() {
+            const n = rows;
+            rows = 0;
+            dropped = 0;
+            warnedFull = false;
+            describe();
+            return `dropped ${plural(n, "row")}`;
+          },
+        },
+        reset: {
+          label: "Reset model",
+          description: "Forget the fitted model (predictions are 0 until the next fit)",
+          run() {
+            model.reset();
+            fittedRows = -1;
+            describe();
+            return "the model is untrained";
+          },
+        },
+        save: {
+          label: "Save model",
+          description: `Write the model to a file (default ${defaultFile})`,
+          run(arg) {
+            const file = fileArg(arg);
+            const text = serializeModel(model, {
+              block: ctx.name,
+              blockType: ctx.type,
+              created: new Date(ctx.now() * 1000).toISOString(),
+              inputSource: feat.info.source,
+              ...(pairsIn ? { targetSource: pairsIn.info.source } : {}),
+            });
+            ctx.resources.writeText(file, text).then(
+              () => {
+                lastSaved = `saved to ${file}`;
+                if (!disposed) describe();
+              },
+              (e: unknown) => ctx.warn(`cannot save the model to ${file}: ${errorMessage(e)}`),
+            );
+            return `saving the model to ${file}`;
+          },
+        },
+        load: {
+          label: "Load model",
+          description: `Replace the model by one from a file (default ${defaultFile})`,
+          run(arg) {
+            const file = fileArg(arg);
+            ctx.resources.readText(file).then(
+              (text) => {
+                if (disposed) return;
+                try {
+                  const r = loadModel(text, file, {
+                    inputs: d,
+                    outputs: M,
+                    inputName: feat.info.source,
+                    targetName: null,
+                  });
+                  model.dispose();
+                  model = r.model;
+                  replaced = true;
+                  fittedRows = -1;
+                  lastSaved = `loaded ${file}: ${describeOptions(r.model.options)}`;
+                  describe();
+                } catch (e) {
+                  ctx.warn(`cannot load the model: ${errorMessage(e)}`);
+                }
+              },
+              (e: unknown) => ctx.warn(`cannot load the model from ${file}: ${errorMessage(e)}`),
+            );
+            return `loading ${file}`;
+          },
+        },
+        inspect: {
+          label: "Inspect",
+          description: "Model, rows kept and the R² of every output",
+          run() {
+            model.r2(r2);
+            return (
+              `${describeOptions(model.options)}: ${plural(rows, "row")} kept, fitted on ` +
+              `${plural(model.samplesSeen(), "row")}; in-sample R² per output ${listR2(r2)}`
+            );
+          },
+        },
+      },
+    };
+  },
+});

@@ -1,0 +1,709 @@
+/**
+ * The model shared by the BatchPredictor and IncrementalPredictor blocks: its params (zod), MOSAIC's
+ * positional forms, and its file format (`docs/model-format.md`): one JSON document, a flat header
+ * a person can read (kind, sizes, hyper-parameters, samples seen, R², date) followed by the arrays
+ * (weights, Ω and b for RFF, the normal equations for incremental learning), matrices one row per
+ * line. Loading validates everything and throws a `ModelFileError` that names the file and what is
+ * wrong with it; the Rust core then checks the numbers (symmetric, positive definite, weights that
+ * match the normal equations).
+ */
+import { z } from "zod";
+import {
+  BlockConfigError,
+  errorMessage,
+  LegacyParamsError,
+  legacyInteger,
+  legacyNumber,
+} from "../../engine";
+import {
+  LEARNING_DEFAULTS,
+  LearningModel,
+  type ModelKindName,
+  type ResolvedLearningOptions,
+} from "../../engine/dsp";
+
+export const MODEL_FORMAT = "mosaic-model";
+export const MODEL_VERSION = 1;
+
+/** Largest input width of a ridge model and largest D of an RFF model (p × p matrices). */
+export const MAX_DIM = 2048;
+export const MAX_OUTPUTS = 4096;
+
+// ---------------------------------------------------------------------------------------------
+// Params
+
+/** The model params both predictor blocks take (fields of their zod object). */
+export const modelParams = {
+  Model: z
+    .enum(["ridge", "rff"])
+    .default("ridge")
+    .describe(
+      "ridge: linear ridge regression (paper eqs. 5–6); rff: ridge on random Fourier features " +
+        "(nonlinear, an RBF-kernel approximation). MOSAIC's names (IncrementalRidgeRegression, " +
+        "IncrementalRFF, RidgeRegression, RR_RFF) load through the positional form",
+    ),
+  Lambda: z
+    .number()
+    .min(1e-50)
+    .max(1e50)
+    .default(1)
+    .describe(
+      "λ from 1e-50 to 1e50, the ridge penalty (larger: smoother, less fitted; MOSAIC's default 1)",
+    ),
+  Gamma: z
+    .number()
+    .gt(0)
+    .default(0.5)
+    .describe(
+      "rff: γ of the RBF kernel exp(−γ‖x − x′‖²) (scikit-learn's RBFSampler gamma); the default " +
+        "0.5 is MOSAIC's σ = 1. With Normalize, about 1 / Inputs is a good start",
+    ),
+  Features: z
+    .number()
+    .int()
+    .min(1)
+    .max(MAX_DIM)
+    .default(300)
+    .describe("rff: D, the number of random features (MOSAIC's default 300)"),
+  Seed: z
+    .number()
+    .int()
+    .min(0)
+    .default(0)
+    .describe("rff: seed of the random features Ω and b (same seed, same model)"),
+  Forgetting: z
+    .number()
+    .gt(0)
+    .max(1)
+    .default(1)
+    .describe(
+      "β in (0, 1]: a sample learnt k samples ago weighs β^k (1 = remember everything; 0.999 " +
+        "halves a sample's weight after 693 samples)",
+    ),
+  Intercept: z
+    .boolean()
+    .default(true)
+    .describe(
+      "Fit an intercept (not penalised, as scikit-learn's Ridge); false: ŷ = Wᵀx exactly as " +
+        "the paper's eq. 6 and MOSAIC 1",
+    ),
+  Normalize: z
+    .boolean()
+    .default(false)
+    .describe(
+      "Standardise every input with the statistics of the training samples (see the help: " +
+        "exact for ridge; for rff the statistics freeze after NormalizeSamples samples)",
+    ),
+  NormalizeSamples: z
+    .number()
+    .int()
+    .min(2)
+    .max(100_000)
+    .default(200)
+    .describe("rff with Normalize: training samples whose statistics are used, then frozen"),
+  Inputs: z
+    .number()
+    .int()
+    .min(1)
+    .optional()
+    .describe("Expected values per feature event (checked against the features input)"),
+  Outputs: z
+    .number()
+    .int()
+    .min(1)
+    .max(MAX_OUTPUTS)
+    .optional()
+    .describe(
+      "Expected values per target and prediction (checked against the target input; needed " +
+        "when there is none and no File)",
+    ),
+  File: z
+    .string()
+    .min(1)
+    .optional()
+    .describe(
+      "Model file (relative to the pipeline file): loaded at start if it exists, and the default " +
+        "file of the save and load actions",
+    ),
+};
+
+export interface ModelParams {
+  Model: ModelKindName;
+  Lambda: number;
+  Gamma: number;
+  Features: number;
+  Seed: number;
+  Forgetting: number;
+  Intercept: boolean;
+  Normalize: boolean;
+  NormalizeSamples: number;
+  Inputs?: number | undefined;
+  Outputs?: number | undefined;
+  File?: string | undefined;
+}
+
+export const MODEL_HELP =
+  "Models (paper III-G): `ridge` fits ŷ = Wᵀx + b with W = (XᵀX + λI)⁻¹XᵀY on centred data, so " +
+  "that the intercept b is not penalised (scikit-learn's `Ridge`; `Intercept: false` gives the " +
+  "paper's eq. 6 as written, MOSAIC 1's model); `rff` first maps x to D random Fourier features " +
+  "z = √(2/D)·cos(Ωx + b), Ω ~ N(0, 2γ), b ~ U(0, 2π) (Rahimi & Recht 2007; scikit-learn's " +
+  "`RBFSampler`), then fits ridge on z. Learning is exact: incremental updates keep the Cholesky " +
+  "factor of the normal equations (one rank-one update per sample), so after n samples the model " +
+  "equals the batch fit of those n samples; `Forgetting` β < 1 weighs older samples less. " +
+  "Samples with a NaN, an infinity or a value beyond ±1e50 are refused and counted. " +
+  "`Normalize` standardises the inputs (mean 0, sd 1 over the training samples; a constant " +
+  "input is only centred): for ridge exactly, as a penalty λ·sd² on each raw weight re-derived " +
+  "whenever an sd moves by 10 % (the centring is the intercept's: without intercept the inputs " +
+  "are only scaled); for rff the statistics freeze after `NormalizeSamples` training samples, " +
+  "which are then learnt again (a one-off cost of that many updates). Model files: JSON, see " +
+  "docs/model-format.md; a file that does not match the inputs is refused with a message naming " +
+  "the file and the mismatch.";
+
+/** The learning options of params, for `inputs` features and `outputs` targets. */
+export function optionsFromParams(
+  p: ModelParams,
+  inputs: number,
+  outputs: number,
+): ResolvedLearningOptions {
+  return {
+    kind: p.Model,
+    inputs,
+    outputs,
+    lambda: p.Lambda,
+    forgetting: p.Forgetting,
+    intercept: p.Intercept,
+    normalize: p.Normalize,
+    normalizeSamples: p.NormalizeSamples,
+    features: p.Features,
+    gamma: p.Gamma,
+    seed: p.Seed,
+  };
+}
+
+/** "rff (D 300, γ 0.5, λ 1)". */
+export function describeOptions(o: ResolvedLearningOptions): string {
+  const parts =
+    o.kind === "rff" ? [`D ${o.features}`, `γ ${o.gamma}`, `λ ${o.lambda}`] : [`λ ${o.lambda}`];
+  if (o.forgetting !== 1) parts.push(`β ${o.forgetting}`);
+  if (!o.intercept) parts.push("no intercept");
+  if (o.normalize) parts.push("normalized");
+  return `${o.kind} (${parts.join(", ")})`;
+}
+
+/** Which params a Rust error is about (for BlockConfigError). */
+function paramOf(message: string): string | undefined {
+  const m = /^(Lambda|Gamma|Features|Forgetting|Inputs|Outputs|NormalizeSamples)\b/.exec(message);
+  return m?.[1];
+}
+
+/** Creates the model; every refusal becomes a BlockConfigError naming the param. */
+export function createModel(o: ResolvedLearningOptions): LearningModel {
+  try {
+    return new LearningModel(o);
+  } catch (e) {
+    const msg = errorMessage(e);
+    throw new BlockConfigError(`cannot create the ${o.kind} model: ${msg}`, paramOf(msg));
+  }
+}
+
+/**
+ * MOSAIC's learning machines by name (`Params: [IncrementalRFF, 8, 12, λ, σ, D]`), as named
+ * params. MOSAIC 1 had no intercept and drew Ω ~ N(0, σ²) with features cos(Ωx + b) without the
+ * √(2/D) factor: the same model here has γ = σ²/2 and λ·2/D.
+ */
+export function legacyMachine(
+  name: string,
+  dims: readonly string[],
+  hyper: readonly string[],
+  accepted: readonly string[],
+): Record<string, unknown> {
+  if (!accepted.includes(name)) {
+    throw new LegacyParamsError(
+      `unknown learning machine '${name}'; expected one of ${accepted.join(", ")}`,
+      "Model",
+    );
+  }
+  if (dims.length < 2) {
+    throw new LegacyParamsError(
+      `expected the input and output sizes after '${name}', e.g. [${name}, 8, 12]`,
+      "Inputs",
+    );
+  }
+  const inputs = legacyInteger(dims[0]!, "input size", "Inputs");
+  const outputs = legacyInteger(dims[1]!, "output size", "Outputs");
+  const lambda = hyper[0] !== undefined ? legacyNumber(hyper[0], "lambda", "Lambda") : 1;
+  const rff = name.includes("RFF");
+  if (!rff) {
+    if (hyper.length > 1) {
+      throw new LegacyParamsError(
+        `${name} takes one hyper-parameter (lambda); got ${hyper.length}`,
+      );
+    }
+    return { Model: "ridge", Inputs: inputs, Outputs: outputs, Lambda: lambda, Intercept: false };
+  }
+  if (hyper.length > 3) {
+    throw new LegacyParamsError(`${name} takes lambda, sigma and D; got ${hyper.length} values`);
+  }
+  const sigma = hyper[1] !== undefined ? legacyNumber(hyper[1], "sigma", "Gamma") : 1;
+  const d = hyper[2] !== undefined ? legacyInteger(hyper[2], "D", "Features") : 300;
+  if (!(d >= 1)) throw new LegacyParamsError(`D is ${d}; expected at least 1`, "Features");
+  return {
+    Model: "rff",
+    Inputs: inputs,
+    Outputs: outputs,
+    Lambda: (lambda * 2) / d,
+    Gamma: (sigma * sigma) / 2,
+    Features: d,
+    Intercept: false,
+  };
+}
+
+// ---------------------------------------------------------------------------------------------
+// Files
+
+/** A model file that cannot be used: the message starts with the file name. */
+export class ModelFileError extends Error {
+  constructor(
+    readonly file: string,
+    problem: string,
+  ) {
+    super(`model file '${file}': ${problem}`);
+    this.name = "ModelFileError";
+  }
+}
+
+/** True for a read error that means "there is no such file" (then a File is simply not there yet). */
+export function isMissingFile(e: unknown): boolean {
+  const code = (e as { code?: unknown } | null)?.code;
+  return code === "ENOENT" || /ENOENT|no such file|not found/i.test(errorMessage(e));
+}
+
+export interface ModelFileMeta {
+  /** Block that wrote it. */
+  block?: string;
+  blockType?: string;
+  /** ISO date of writing. */
+  created: string;
+  /** Where the inputs came from (the features input's source), for people reading the file. */
+  inputSource?: string;
+  targetSource?: string;
+  featureNames?: readonly string[];
+}
+
+/** A read model file, ready to build the model from. */
+export interface ModelFile {
+  options: ResolvedLearningOptions;
+  samplesSeen: number;
+  created: string;
+  block: string | null;
+  /** The flat state in the model's section order (see `LearningModel.stateSections`). */
+  state: Float64Array;
+}
+
+const num = (x: number): string => (Number.isFinite(x) ? String(x) : "null");
+
+function vector(v: ArrayLike<number>, from = 0, to = v.length): string {
+  const parts: string[] = [];
+  for (let i = from; i < to; i++) parts.push(num(v[i]!));
+  return `[${parts.join(", ")}]`;
+}
+
+function matrix(v: ArrayLike<number>, at: number, rows: number, cols: number, ind: string): string {
+  const lines: string[] = [];
+  for (let r = 0; r < rows; r++)
+    lines.push(`${ind}  ${vector(v, at + r * cols, at + (r + 1) * cols)}`);
+  return `[\n${lines.join(",\n")}\n${ind}]`;
+}
+
+/** Writes a model as a model file (text). */
+export function serializeModel(model: LearningModel, meta: ModelFileMeta): string {
+  const o = model.options;
+  const p = model.dim;
+  const m = o.outputs;
+  const d = o.inputs;
+  const state = model.saveState();
+  const at: Record<string, number> = {};
+  let k = 0;
+  for (const s of model.stateSections()) {
+    at[s.name] = k;
+    k += s.length;
+  }
+  const r2 = new Float64Array(m);
+  model.r2(r2);
+  const rff = o.kind === "rff";
+  const sec = (name: string): number => {
+    const i = at[name];
+    if (i === undefined) throw new Error(`model state has no section '${name}'`);
+    return i;
+  };
+  const meta3 = sec("meta");
+  const h = (key: string, value: unknown): string => `  ${JSON.stringify(key)}: ${value as string}`;
+  const lines: string[] = [
+    h("format", JSON.stringify(MODEL_FORMAT)),
+    h("version", MODEL_VERSION),
+    h("kind", JSON.stringify(o.kind)),
+    h("inputs", d),
+    h("outputs", m),
+    h("lambda", num(o.lambda)),
+    h("gamma", rff ? num(o.gamma) : "null"),
+    h("D", rff ? o.features : "null"),
+    h("seed", rff ? o.seed : "null"),
+    h("forgetting", num(o.forgetting)),
+    h("intercept", o.intercept),
+    h("normalize", o.normalize),
+    h("normalizeSamples", rff && o.normalize ? o.normalizeSamples : "null"),
+    h("samplesSeen", state[meta3]!),
+    h("lambdaEffective", num(state[meta3 + 2]!)),
+    h("r2", vector(r2)),
+    h("created", JSON.stringify(meta.created)),
+    h("block", meta.block !== undefined ? JSON.stringify(meta.block) : "null"),
+    h("blockType", meta.blockType !== undefined ? JSON.stringify(meta.blockType) : "null"),
+    h("inputSource", meta.inputSource !== undefined ? JSON.stringify(meta.inputSource) : "null"),
+    h("targetSource", meta.targetSource !== undefined ? JSON.stringify(meta.targetSource) : "null"),
+    h("featureNames", meta.featureNames ? JSON.stringify(meta.featureNames) : "null"),
+  ];
+  const ind = "    ";
+  const model_: string[] = [
+    `${ind}"weights": ${matrix(state, sec("weights"), p, m, ind)}`,
+    `${ind}"intercept": ${vector(state, sec("intercept"), sec("intercept") + m)}`,
+    `${ind}"penalty": ${vector(state, sec("penalty"), sec("penalty") + p)}`,
+  ];
+  if (rff) {
+    model_.push(`${ind}"omega": ${matrix(state, sec("omega"), p, d, ind)}`);
+    model_.push(`${ind}"offset": ${vector(state, sec("offset"), sec("offset") + p)}`);
+  }
+  lines.push(`  "model": {\n${model_.join(",\n")}\n  }`);
+  if (o.normalize) {
+    const n0 = sec("normalizer");
+    lines.push(
+      `  "normalizer": {"count": ${num(state[n0]!)}, "frozen": ${state[n0 + 1] === 1}, ` +
+        `"mean": ${vector(state, n0 + 2, n0 + 2 + d)}, "m2": ${vector(state, n0 + 2 + d, n0 + 2 + 2 * d)}}`,
+    );
+  } else {
+    lines.push(`  "normalizer": null`);
+  }
+  const f0 = sec("fit_stats");
+  const st: string[] = [
+    `${ind}"weightSum": ${num(state[meta3 + 1]!)}`,
+    `${ind}"xMean": ${vector(state, sec("x_mean"), sec("x_mean") + p)}`,
+    `${ind}"yMean": ${vector(state, sec("y_mean"), sec("y_mean") + m)}`,
+    `${ind}"scatter": ${matrix(state, sec("scatter"), p, p, ind)}`,
+    `${ind}"cross": ${matrix(state, sec("cross"), p, m, ind)}`,
+    `${ind}"fitStats": {"weight": ${num(state[f0]!)}, "mean": ${vector(state, f0 + 1, f0 + 1 + m)}, ` +
+      `"m2": ${vector(state, f0 + 1 + m, f0 + 1 + 2 * m)}, "sse": ${vector(state, f0 + 1 + 2 * m, f0 + 1 + 3 * m)}}`,
+  ];
+  lines.push(`  "state": {\n${st.join(",\n")}\n  }`);
+  return `{\n${lines.join(",\n")}\n}\n`;
+}
+
+type Json = unknown;
+
+/** Validating accessors that name the path of what is wrong. */
+class Check {
+  constructor(readonly file: string) {}
+
+  fail(problem: string): never {
+    throw new ModelFileError(this.file, problem);
+  }
+
+  object(v: Json, path: string): Record<string, Json> {
+    if (typeof v !== "object" || v === null || Array.isArray(v)) {
+      this.fail(`${path} is ${describe(v)}; expected an object`);
+    }
+    return v as Record<string, Json>;
+  }
+
+  number(v: Json, path: string, ok: (x: number) => boolean, expected: string): number {
+    if (typeof v !== "number" || !Number.isFinite(v) || !ok(v)) {
+      this.fail(`${path} is ${describe(v)}; expected ${expected}`);
+    }
+    return v;
+  }
+
+  int(v: Json, path: string, min: number, max: number, expected: string): number {
+    return this.number(v, path, (x) => Number.isInteger(x) && x >= min && x <= max, expected);
+  }
+
+  bool(v: Json, path: string): boolean {
+    if (typeof v !== "boolean") this.fail(`${path} is ${describe(v)}; expected true or false`);
+    return v;
+  }
+
+  /** `len` finite numbers into `out` at `at`. */
+  vector(v: Json, path: string, len: number, what: string, out: Float64Array, at: number): void {
+    if (!Array.isArray(v))
+      this.fail(`${path} is ${describe(v)}; expected a list of ${len} numbers`);
+    if (v.length !== len) this.fail(`${path} has ${v.length} values; expected ${len} (${what})`);
+    for (let i = 0; i < len; i++) {
+      const x: Json = v[i];
+      if (typeof x !== "number" || !Number.isFinite(x)) {
+        this.fail(`${path}[${i}] is ${describe(x)}; expected a finite number`);
+      }
+      out[at + i] = x;
+    }
+  }
+
+  /** `rows` lists of `cols` finite numbers, row-major into `out` at `at`. */
+  matrix(
+    v: Json,
+    path: string,
+    rows: number,
+    cols: number,
+    rowWhat: string,
+    colWhat: string,
+    out: Float64Array,
+    at: number,
+  ): void {
+    if (!Array.isArray(v)) {
+      this.fail(`${path} is ${describe(v)}; expected ${rows} rows of ${cols} numbers`);
+    }
+    if (v.length !== rows) this.fail(`${path} has ${v.length} rows; expected ${rows} (${rowWhat})`);
+    for (let r = 0; r < rows; r++) {
+      this.vector(v[r], `${path}[${r}]`, cols, colWhat, out, at + r * cols);
+    }
+  }
+}
+
+function describe(v: Json): string {
+  if (v === undefined) return "missing";
+  if (v === null) return "null";
+  if (typeof v === "string") return `"${v.length > 30 ? v.slice(0, 30) + "…" : v}"`;
+  if (Array.isArray(v)) return `a list of ${v.length}`;
+  if (typeof v === "object") return "an object";
+  return String(v);
+}
+
+/**
+ * Reads and checks a model file's text (structure, sizes, hyper-parameters, every array's shape
+ * and values). The numbers themselves are checked again by the Rust core when the state is
+ * loaded (`buildModel`).
+ */
+export function parseModelFile(text: string, file: string): ModelFile {
+  const c = new Check(file);
+  let doc: Json;
+  try {
+    doc = JSON.parse(text);
+  } catch (e) {
+    c.fail(`not a MOSAIC model file: invalid JSON (${errorMessage(e)})`);
+  }
+  const top = c.object(doc, "the file");
+  if (top.format !== MODEL_FORMAT) {
+    c.fail(
+      `not a MOSAIC model file: "format" is ${describe(top.format)}; expected "${MODEL_FORMAT}"`,
+    );
+  }
+  const version = c.int(top.version, "version", 1, Number.MAX_SAFE_INTEGER, "a whole number");
+  if (version > MODEL_VERSION) {
+    c.fail(
+      `format version ${version} is newer than this MOSAIC reads (${MODEL_VERSION}); update MOSAIC`,
+    );
+  }
+  if (top.kind !== "ridge" && top.kind !== "rff") {
+    c.fail(`kind is ${describe(top.kind)}; expected "ridge" or "rff"`);
+  }
+  const kind = top.kind as ModelKindName;
+  const rff = kind === "rff";
+  const d = c.int(top.inputs, "inputs", 1, rff ? 1 << 22 : MAX_DIM, "a whole number of inputs");
+  const m = c.int(top.outputs, "outputs", 1, MAX_OUTPUTS, "a whole number of outputs (1–4096)");
+  const options: ResolvedLearningOptions = {
+    kind,
+    inputs: d,
+    outputs: m,
+    lambda: c.number(
+      top.lambda,
+      "lambda",
+      (x) => x >= 1e-50 && x <= 1e50,
+      "a number from 1e-50 to 1e50",
+    ),
+    forgetting: c.number(
+      top.forgetting,
+      "forgetting",
+      (x) => x > 0 && x <= 1,
+      "a number in (0, 1]",
+    ),
+    intercept: c.bool(top.intercept, "intercept"),
+    normalize: c.bool(top.normalize, "normalize"),
+    normalizeSamples: LEARNING_DEFAULTS.normalizeSamples,
+    features: LEARNING_DEFAULTS.features,
+    gamma: LEARNING_DEFAULTS.gamma,
+    seed: 0,
+  };
+  if (rff) {
+    options.gamma = c.number(top.gamma, "gamma", (x) => x > 0, "a number > 0");
+    options.features = c.int(top.D, "D", 1, MAX_DIM, "a whole number of features (1–2048)");
+    options.seed = c.int(top.seed ?? 0, "seed", 0, Number.MAX_SAFE_INTEGER, "a whole number >= 0");
+    if (options.normalize) {
+      options.normalizeSamples = c.int(
+        top.normalizeSamples,
+        "normalizeSamples",
+        2,
+        100_000,
+        "a whole number of samples (2–100000)",
+      );
+    }
+  }
+  const samples = c.int(
+    top.samplesSeen,
+    "samplesSeen",
+    0,
+    Number.MAX_SAFE_INTEGER,
+    "a whole number >= 0",
+  );
+  const lambdaEff = c.number(top.lambdaEffective, "lambdaEffective", (x) => x > 0, "a number > 0");
+  const created = typeof top.created === "string" ? top.created : "";
+  const block = typeof top.block === "string" ? top.block : null;
+  const p = rff ? options.features : d;
+  const model = c.object(top.model, "model");
+  const st = c.object(top.state, "state");
+  const fitStats = c.object(st.fitStats, "state.fitStats");
+  const norm = options.normalize ? c.object(top.normalizer, "normalizer") : null;
+
+  // The flat state, in the Rust section order (mosaic-learn `Model::state_sections`).
+  const sections: [string, number][] = [];
+  if (options.normalize) sections.push(["normalizer", 2 + 2 * d]);
+  if (rff) sections.push(["omega", p * d], ["offset", p]);
+  sections.push(
+    ["meta", 3],
+    ["penalty", p],
+    ["x_mean", p],
+    ["y_mean", m],
+    ["scatter", p * p],
+    ["cross", p * m],
+    ["weights", p * m],
+    ["intercept", m],
+    ["fit_stats", 1 + 3 * m],
+  );
+  const state = new Float64Array(sections.reduce((s, x) => s + x[1], 0));
+  const inputs = rff ? "one per feature" : "one per input";
+  let at = 0;
+  for (const [name, len] of sections) {
+    switch (name) {
+      case "normalizer": {
+        const n = norm!;
+        state[at] = c.number(n.count, "normalizer.count", (x) => x >= 0, "a count >= 0");
+        state[at + 1] = c.bool(n.frozen, "normalizer.frozen") ? 1 : 0;
+        c.vector(n.mean, "normalizer.mean", d, "one per input", state, at + 2);
+        c.vector(n.m2, "normalizer.m2", d, "one per input", state, at + 2 + d);
+        break;
+      }
+      case "omega":
+        c.matrix(model.omega, "model.omega", p, d, "one per feature", "one per input", state, at);
+        break;
+      case "offset":
+        c.vector(model.offset, "model.offset", p, "one per feature", state, at);
+        break;
+      case "meta":
+        state[at] = samples;
+        state[at + 1] = c.number(st.weightSum, "state.weightSum", (x) => x >= 0, "a number >= 0");
+        state[at + 2] = lambdaEff;
+        break;
+      case "penalty":
+        c.vector(model.penalty, "model.penalty", p, inputs, state, at);
+        break;
+      case "x_mean":
+        c.vector(st.xMean, "state.xMean", p, inputs, state, at);
+        break;
+      case "y_mean":
+        c.vector(st.yMean, "state.yMean", m, "one per output", state, at);
+        break;
+      case "scatter":
+        c.matrix(st.scatter, "state.scatter", p, p, inputs, inputs, state, at);
+        break;
+      case "cross":
+        c.matrix(st.cross, "state.cross", p, m, inputs, "one per output", state, at);
+        break;
+      case "weights":
+        c.matrix(model.weights, "model.weights", p, m, inputs, "one per output", state, at);
+        break;
+      case "intercept":
+        c.vector(model.intercept, "model.intercept", m, "one per output", state, at);
+        break;
+      case "fit_stats":
+        state[at] = c.number(
+          fitStats.weight,
+          "state.fitStats.weight",
+          (x) => x >= 0,
+          "a number >= 0",
+        );
+        c.vector(fitStats.mean, "state.fitStats.mean", m, "one per output", state, at + 1);
+        c.vector(fitStats.m2, "state.fitStats.m2", m, "one per output", state, at + 1 + m);
+        c.vector(fitStats.sse, "state.fitStats.sse", m, "one per output", state, at + 1 + 2 * m);
+        break;
+    }
+    at += len;
+  }
+  return { options, samplesSeen: samples, created, block, state };
+}
+
+/**
+ * Creates the model a file describes and loads its state (the Rust core checks the numbers:
+ * symmetric positive-definite scatter, weights that match the normal equations, …).
+ */
+export function buildModel(f: ModelFile, file: string): LearningModel {
+  let model: LearningModel;
+  try {
+    model = new LearningModel(f.options);
+  } catch (e) {
+    throw new ModelFileError(file, `its hyper-parameters are refused: ${errorMessage(e)}`);
+  }
+  const names = model.stateSections().reduce((s, x) => s + x.length, 0);
+  if (names !== f.state.length) {
+    model.dispose();
+    throw new ModelFileError(
+      file,
+      `its state has ${f.state.length} values; the model needs ${names}`,
+    );
+  }
+  try {
+    model.loadState(f.state);
+  } catch (e) {
+    model.dispose();
+    throw new ModelFileError(file, errorMessage(e));
+  }
+  return model;
+}
+
+/** Reads, checks and builds a model file against the block's sizes. */
+export function loadModel(
+  text: string,
+  file: string,
+  expect: { inputs: number; outputs: number | null; inputName: string; targetName: string | null },
+): { model: LearningModel; file: ModelFile } {
+  const f = parseModelFile(text, file);
+  const o = f.options;
+  if (o.inputs !== expect.inputs) {
+    throw new ModelFileError(
+      file,
+      `the model has ${o.inputs} inputs but input '${expect.inputName}' carries ${expect.inputs} ` +
+        "values per event",
+    );
+  }
+  if (expect.outputs !== null && o.outputs !== expect.outputs) {
+    throw new ModelFileError(
+      file,
+      `the model has ${o.outputs} outputs but ` +
+        (expect.targetName !== null
+          ? `the target input '${expect.targetName}' carries ${expect.outputs} values per event`
+          : `Outputs is ${expect.outputs}`),
+    );
+  }
+  return { model: buildModel(f, file), file: f };
+}
+
+/** Mean of the defined R² values, for status texts: "R² 0.82", or "R² –". */
+export function formatR2(r2: Float64Array): string {
+  let s = 0;
+  let n = 0;
+  for (const v of r2) {
+    if (Number.isFinite(v)) {
+      s += v;
+      n++;
+    }
+  }
+  return n === 0 ? "R² –" : `R² ${(s / n).toFixed(2)}`;
+}
+
+/** Per-output R² as a list: "[0.91, 0.75, –]". */
+export function listR2(r2: Float64Array): string {
+  return `[${Array.from(r2, (v) => (Number.isFinite(v) ? v.toFixed(3) : "–")).join(", ")}]`;
+}
