@@ -36,12 +36,16 @@ export class EngineClient {
   private readonly eventListeners = new Set<(e: RuntimeEvent) => void>();
   private readonly stateListeners = new Set<(s: EngineState) => void>();
   private readonly dataListeners = new Map<string, Set<DataListener>>();
+  private readonly helloListeners = new Set<() => void>();
+  private readonly graphListeners = new Set<(g: GraphInfo | undefined) => void>();
   private readonly off: () => void;
   telemetry: Telemetry | undefined;
   state: EngineState = "empty";
   graph: GraphInfo | undefined;
   engineName = "";
   sharedMemory = false;
+  /** True once the engine answered `hello`. */
+  connected = false;
 
   constructor(readonly connection: EngineConnection) {
     this.off = connection.onMessage((m) => this.receive(m));
@@ -53,6 +57,8 @@ export class EngineClient {
       case "hello":
         this.engineName = m.engine;
         this.sharedMemory = m.sharedMemory;
+        this.connected = true;
+        for (const l of this.helloListeners) l();
         break;
       case "reply": {
         const r = this.pending.get(m.id);
@@ -89,6 +95,7 @@ export class EngineClient {
   async load(file: string, source: string): Promise<Reply> {
     const r = await this.request({ type: "load", file, source });
     this.graph = r.graph;
+    for (const l of this.graphListeners) l(this.graph);
     return r;
   }
 
@@ -100,8 +107,12 @@ export class EngineClient {
     return this.request({ type: "stop" });
   }
 
-  setParam(block: string, param: string, value: unknown): Promise<Reply> {
-    return this.request({ type: "setParam", block, param, value });
+  /** Sets a live param; on success the param is also updated in `graph` (what panels show). */
+  async setParam(block: string, param: string, value: unknown): Promise<Reply> {
+    const r = await this.request({ type: "setParam", block, param, value });
+    const info = r.ok ? this.graph?.blocks.find((b) => b.name === block) : undefined;
+    if (info) info.params = { ...info.params, [param]: value };
+    return r;
   }
 
   invoke(block: string, action: string, arg?: unknown): Promise<Reply> {
@@ -116,6 +127,18 @@ export class EngineClient {
   onEvent(l: (e: RuntimeEvent) => void): () => void {
     this.eventListeners.add(l);
     return () => this.eventListeners.delete(l);
+  }
+
+  /** Called when the engine answers `hello` (engine name, shared memory). */
+  onHello(l: () => void): () => void {
+    this.helloListeners.add(l);
+    return () => this.helloListeners.delete(l);
+  }
+
+  /** Called after every `load` with the new graph (undefined when the pipeline has errors). */
+  onGraph(l: (g: GraphInfo | undefined) => void): () => void {
+    this.graphListeners.add(l);
+    return () => this.graphListeners.delete(l);
   }
 
   onState(l: (s: EngineState) => void): () => void {

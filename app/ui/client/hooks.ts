@@ -1,6 +1,14 @@
 /** React bindings of EngineClient. */
-import { useEffect, useRef, useState, createContext, useContext } from "react";
-import type { DataMessage, EngineState } from "../../engine/protocol";
+import {
+  createContext,
+  useCallback,
+  useContext,
+  useEffect,
+  useRef,
+  useState,
+  useSyncExternalStore,
+} from "react";
+import type { DataMessage, EngineState, GraphInfo } from "../../engine/protocol";
 import type { Telemetry } from "../../engine/runtime/runtime";
 import type { EngineClient } from "./engine-client";
 
@@ -45,4 +53,69 @@ export function useBlockData(
     if (!active) return undefined;
     return client.watch(block, port, (m) => cb.current(m), maxRate);
   }, [client, block, port, active, maxRate]);
+}
+
+/** What the engine said in `hello`: its name and whether it has shared memory (precise timing). */
+export function useEngineInfo(): { connected: boolean; engine: string; sharedMemory: boolean } {
+  const client = useEngine();
+  const [, bump] = useState(0);
+  useEffect(() => client.onHello(() => bump((n) => n + 1)), [client]);
+  return {
+    connected: client.connected,
+    engine: client.engineName,
+    sharedMemory: client.sharedMemory,
+  };
+}
+
+/** The graph of the loaded pipeline (undefined before a load and after a failed one). */
+export function useGraph(): GraphInfo | undefined {
+  const client = useEngine();
+  const [g, setG] = useState(client.graph);
+  useEffect(() => client.onGraph(setG), [client]);
+  return g;
+}
+
+/**
+ * A value derived from the latest telemetry: the component re-renders only when `select` gives a
+ * result that `isEqual` says differs from the previous one (shallow equality by default), so a
+ * node whose label did not change does not render at 20 Hz.
+ */
+export function useTelemetrySelector<T>(
+  select: (t: Telemetry | undefined) => T,
+  isEqual: (a: T, b: T) => boolean = shallowEqual,
+): T {
+  const client = useEngine();
+  const selectRef = useRef(select);
+  const cache = useRef<{ t: Telemetry | undefined; fresh: boolean; value: T } | null>(null);
+  if (selectRef.current !== select) {
+    // A new selector (its inputs changed): recompute, keeping the old value if equal.
+    selectRef.current = select;
+    if (cache.current) cache.current.fresh = false;
+  }
+  const getSnapshot = useCallback((): T => {
+    const t = client.telemetry;
+    const c = cache.current;
+    if (c && c.fresh && c.t === t) return c.value;
+    const next = selectRef.current(t);
+    const value = c && isEqual(c.value, next) ? c.value : next;
+    cache.current = { t, fresh: true, value };
+    return value;
+    // `isEqual` is read at call time: callers pass a module-level function.
+  }, [client]);
+  const subscribe = useCallback((cb: () => void) => client.onTelemetry(cb), [client]);
+  return useSyncExternalStore(subscribe, getSnapshot, getSnapshot);
+}
+
+/** Shallow equality of two plain objects (or identical values). */
+export function shallowEqual<T>(a: T, b: T): boolean {
+  if (Object.is(a, b)) return true;
+  if (typeof a !== "object" || typeof b !== "object" || a === null || b === null) return false;
+  const ka = Object.keys(a);
+  const kb = Object.keys(b);
+  if (ka.length !== kb.length) return false;
+  for (const k of ka) {
+    if (!Object.is((a as Record<string, unknown>)[k], (b as Record<string, unknown>)[k]))
+      return false;
+  }
+  return true;
 }

@@ -1,0 +1,113 @@
+/**
+ * Loading pipelines: the list of examples (pipelines/index.json of the browser build), fetching a
+ * file, sending `load` and, when it loads, `start`. Keeps the file's text for "Save layout" and
+ * the diagnostics of a file that does not load.
+ */
+import { useCallback, useEffect, useRef, useState } from "react";
+import type { Diagnostic } from "../../engine/diagnostics";
+import type { GraphInfo } from "../../engine/protocol";
+import type { EngineClient, Reply } from "../client/engine-client";
+
+export interface PipelineEntry {
+  file: string;
+  title: string;
+}
+
+export interface PipelineState {
+  /** Examples offered by the picker. */
+  index: PipelineEntry[];
+  /** What the picker shows. */
+  selected: string;
+  /** The file being loaded or loaded last. */
+  file: string | undefined;
+  source: string | undefined;
+  graph: GraphInfo | undefined;
+  /** Increases with every load (a key for components that start fresh per load). */
+  generation: number;
+  loading: boolean;
+  diagnostics: Diagnostic[];
+  /** A problem that is not in the file (network, engine). */
+  error: string | undefined;
+}
+
+export const DEFAULT_PIPELINE = "pipelines/demo.yaml";
+
+export function usePipeline(client: EngineClient, initial: string) {
+  const [s, setS] = useState<PipelineState>({
+    index: [],
+    selected: initial,
+    file: undefined,
+    source: undefined,
+    graph: undefined,
+    generation: 0,
+    loading: false,
+    diagnostics: [],
+    error: undefined,
+  });
+  const busy = useRef(0);
+
+  useEffect(() => {
+    let cancelled = false;
+    fetch("pipelines/index.json")
+      .then((r) => (r.ok ? (r.json() as Promise<PipelineEntry[]>) : []))
+      .then((index) => {
+        if (!cancelled) setS((p) => ({ ...p, index }));
+      })
+      .catch(() => {
+        /* no index: the picker offers the current file only */
+      });
+    return () => {
+      cancelled = true;
+    };
+  }, []);
+
+  /** Loads `file` with `source` (already read) and starts it when it loads. */
+  const loadSource = useCallback(
+    async (file: string, source: string, autostart = true): Promise<Reply> => {
+      const ticket = ++busy.current;
+      setS((p) => ({ ...p, loading: true, file, error: undefined }));
+      const r = await client.load(file, source);
+      if (ticket !== busy.current) return { ok: false, message: "another load started" };
+      setS((p) => ({
+        ...p,
+        loading: false,
+        file,
+        source,
+        graph: r.graph,
+        generation: p.generation + 1,
+        diagnostics: r.diagnostics ?? [],
+        error: r.ok || (r.diagnostics?.length ?? 0) > 0 ? undefined : (r.message ?? "cannot load"),
+      }));
+      if (r.ok && autostart) await client.start();
+      return r;
+    },
+    [client],
+  );
+
+  /** Fetches a file of the build (relative to the page) and loads it. */
+  const load = useCallback(
+    async (file: string, autostart = true): Promise<Reply> => {
+      setS((p) => ({ ...p, selected: file }));
+      let text: string;
+      try {
+        const r = await fetch(file);
+        if (!r.ok) throw new Error(`HTTP ${r.status} ${r.statusText}`.trim());
+        text = await r.text();
+      } catch (e) {
+        setS((p) => ({
+          ...p,
+          file,
+          loading: false,
+          error: `Cannot read ${file}: ${(e as Error).message}`,
+        }));
+        return { ok: false, message: `cannot read ${file}` };
+      }
+      return loadSource(file, text, autostart);
+    },
+    [loadSource],
+  );
+
+  const select = useCallback((file: string) => setS((p) => ({ ...p, selected: file })), []);
+
+  return { ...s, load, loadSource, select };
+}

@@ -1,0 +1,288 @@
+/**
+ * Status tab: the last minute of the block's timing status as a strip of colours (with the word
+ * and share of each status: colour is never the only signal), its actual rate against the
+ * desired one, and its figures — compute time (mean / max), drops on its inputs, errors and the
+ * last error, its status text and, for timers, ticks and lateness. The history is recorded from
+ * telemetry (20 Hz) for as long as the panel exists, visible or not (telemetry flows anyway);
+ * drawing happens only while the tab is shown.
+ */
+import { useCallback, useEffect, useMemo, useRef, useState, type ReactNode } from "react";
+import type { BlockInfo } from "../../engine/protocol";
+import type { BlockTelemetry } from "../../engine/runtime/runtime";
+import type { Status } from "../../engine/runtime/status";
+import { useEngine } from "../client/hooks";
+import { StatusIcon, STATUS_HELP, statusText } from "../graph/status";
+import { formatValue } from "./channels";
+import { fitCanvas, readTheme, useWidth } from "./canvas";
+import { onFrame } from "./frame";
+import { STATUS_ORDER, StatusHistory } from "./status-history";
+
+export interface StatusRecorder {
+  history: StatusHistory;
+  latest: BlockTelemetry | undefined;
+  version: number;
+}
+
+/** Records the block's telemetry while the calling component is mounted. */
+export function useStatusRecorder(block: string): StatusRecorder {
+  const client = useEngine();
+  const rec = useMemo<StatusRecorder>(
+    () => ({ history: new StatusHistory(60), latest: undefined, version: 0 }),
+    [block],
+  );
+  useEffect(
+    () =>
+      client.onTelemetry((t) => {
+        const b = t.blocks.find((x) => x.name === block);
+        if (!b) return;
+        rec.latest = b;
+        rec.history.push(t.t, b.status, b.rate, b.computeMeanMs, b.computeMaxMs);
+        rec.version++;
+      }),
+    [client, block, rec],
+  );
+  return rec;
+}
+
+const STATUS_FALLBACK: Record<Status, string> = {
+  ontime: "#1a9850",
+  lagging: "#d73027",
+  stumbling: "#c51b7d",
+  idle: "#8c8c8c",
+};
+const REFRESH_MS = 250;
+const HEIGHT = 132;
+const STRIP_H = 22;
+
+export function StatusView({
+  block,
+  recorder,
+  active,
+}: {
+  block: BlockInfo;
+  recorder: StatusRecorder;
+  active: boolean;
+}): ReactNode {
+  const [, setTick] = useState(0);
+  const canvas = useRef<HTMLCanvasElement>(null);
+  const wrap = useRef<HTMLDivElement>(null);
+  const width = useRef(0);
+  const seen = useRef(-1);
+  const draw = useCallback(() => {
+    const c = canvas.current;
+    if (c && width.current > 0)
+      drawHistory(c, width.current, HEIGHT, recorder.history, block.desiredRate);
+  }, [recorder, block.desiredRate]);
+  const onResize = useCallback(
+    (w: number) => {
+      width.current = w;
+      draw();
+    },
+    [draw],
+  );
+  useWidth(wrap, onResize);
+  useEffect(() => {
+    if (!active) return undefined;
+    let last = 0;
+    return onFrame((now) => {
+      if (recorder.version === seen.current || now - last < REFRESH_MS) return;
+      seen.current = recorder.version;
+      last = now;
+      draw();
+      setTick((x) => x + 1);
+    });
+  }, [active, recorder, draw]);
+
+  const b = recorder.latest;
+  const sum = recorder.history.summary();
+  const status: Status = b?.status ?? "idle";
+  return (
+    <div className="mp-statusview" data-view="status" data-block={block.name}>
+      <div className="mp-status-now">
+        <span className={`mp-status-badge mp-st-${status}`} title={STATUS_HELP[status]}>
+          <StatusIcon status={status} /> {statusText(status, b?.stumbling ?? false)}
+        </span>
+        <span>
+          <strong>{b ? b.rate.toFixed(b.rate >= 100 ? 0 : 1) : "—"}</strong> Hz of{" "}
+          {formatHz(block.desiredRate)}
+        </span>
+        {b?.text ? <span className="mp-status-text-inline">{b.text}</span> : null}
+      </div>
+      <div ref={wrap} className="mp-canvas-wrap" style={{ height: HEIGHT }}>
+        <canvas
+          ref={canvas}
+          role="img"
+          aria-label={`Status of ${block.name} over the last minute: ${STATUS_ORDER.map((s) => `${statusText(s, false)} ${Math.round(sum.fraction[s] * 100)} %`).join(", ")}`}
+        />
+      </div>
+      <ul className="mp-status-legend" aria-label="Share of the last minute">
+        {STATUS_ORDER.map((s) => (
+          <li key={s} title={STATUS_HELP[s]}>
+            <span className={`mp-swatch mp-st-bg-${s}`} aria-hidden="true" /> {statusText(s, false)}{" "}
+            <strong>{Math.round(sum.fraction[s] * 100)} %</strong>
+          </li>
+        ))}
+        <li className="mp-muted">last {Math.round(Math.min(60, sum.samples / 20))} s</li>
+      </ul>
+      {b ? (
+        <dl className="mp-figures">
+          <Figure
+            term="Compute (last 50 ms)"
+            value={`mean ${ms(b.computeMeanMs)}, max ${ms(b.computeMaxMs)}`}
+          />
+          <Figure
+            term="Compute (last minute)"
+            value={`mean ${ms(sum.computeMeanMs)}, max ${ms(sum.computeMaxMs)}`}
+          />
+          <Figure
+            term="Period"
+            value={block.desiredRate > 0 ? ms(1000 / block.desiredRate) : "—"}
+          />
+          <Figure
+            term="Rate (last minute)"
+            value={`${formatValue(sum.rateMin)}–${formatValue(sum.rateMax)} Hz`}
+          />
+          <Figure term="Events" value={String(b.events)} />
+          <Figure term="Latency" value={ms(b.latencyMs)} />
+          <Figure term="Dropped on inputs" value={String(b.dropsIn)} warn={b.dropsIn > 0} />
+          <Figure term="Errors" value={String(b.errors)} warn={b.errors > 0} />
+          {b.timer && (
+            <>
+              <Figure
+                term="Ticks"
+                value={`${b.timer.fired} fired, ${b.timer.missed} missed${b.timer.running ? "" : " (stopped)"}`}
+                warn={b.timer.missed > 0}
+              />
+              <Figure
+                term="Lateness"
+                value={`p50 ${b.timer.latenessP50Us.toFixed(0)} µs, p99 ${b.timer.latenessP99Us.toFixed(0)} µs, max ${b.timer.latenessMaxUs.toFixed(0)} µs`}
+              />
+            </>
+          )}
+          {b.lastError && (
+            <div className="mp-figure mp-lasterror">
+              <dt>Last error</dt>
+              <dd role="alert">{b.lastError}</dd>
+            </div>
+          )}
+        </dl>
+      ) : (
+        <p className="mp-muted">No telemetry yet: it arrives while the pipeline runs.</p>
+      )}
+    </div>
+  );
+}
+
+function Figure({ term, value, warn }: { term: string; value: string; warn?: boolean }): ReactNode {
+  return (
+    <div className={`mp-figure${warn ? " mp-warn" : ""}`}>
+      <dt>{term}</dt>
+      <dd>{value}</dd>
+    </div>
+  );
+}
+
+const ms = (x: number): string =>
+  x >= 100 ? `${x.toFixed(0)} ms` : x >= 1 ? `${x.toFixed(2)} ms` : `${(x * 1000).toFixed(0)} µs`;
+const formatHz = (x: number): string => (x > 0 ? `${formatValue(x)} Hz` : "— (event-driven)");
+
+function statusColors(el: Element): Record<Status, string> {
+  const css = getComputedStyle(el);
+  const out = { ...STATUS_FALLBACK };
+  for (const s of STATUS_ORDER)
+    out[s] = css.getPropertyValue(`--status-${s}`).trim() || STATUS_FALLBACK[s];
+  return out;
+}
+
+function drawHistory(
+  canvas: HTMLCanvasElement,
+  width: number,
+  height: number,
+  h: StatusHistory,
+  desired: number,
+): void {
+  const ctx = fitCanvas(canvas, width, height);
+  if (!ctx) return;
+  const theme = readTheme(canvas);
+  const colors = statusColors(canvas);
+  ctx.clearRect(0, 0, width, height);
+  const left = 44;
+  const right = width - 6;
+  const w = Math.max(10, right - left);
+  const newest = h.newestT;
+  const from = newest - h.seconds;
+  const xOf = (t: number): number => left + ((t - from) / h.seconds) * w;
+  // The strip.
+  ctx.fillStyle = theme.grid;
+  ctx.fillRect(left, 0, w, STRIP_H);
+  let prevX = NaN;
+  h.forEach((t, s) => {
+    const x = xOf(t);
+    const x0 = Number.isFinite(prevX) && x - prevX < 4 ? prevX : x - w / (h.seconds * 20);
+    ctx.fillStyle = colors[s];
+    ctx.fillRect(x0, 0, Math.max(1, x - x0 + 0.5), STRIP_H);
+    prevX = x;
+  });
+  ctx.fillStyle = theme.muted;
+  ctx.font = "10px system-ui, sans-serif";
+  ctx.textBaseline = "middle";
+  ctx.textAlign = "right";
+  ctx.fillText("status", left - 4, STRIP_H / 2);
+  // The rate.
+  const top = STRIP_H + 8;
+  const bottom = height - 14;
+  let seen = 0;
+  h.forEach((_t, _s, rate) => {
+    if (rate > seen) seen = rate;
+  });
+  // Up to twice the desired rate: a momentary burst must not flatten the line.
+  let maxRate =
+    desired > 0 ? Math.min(Math.max(desired * 1.2, seen * 1.05), desired * 2) : seen * 1.05;
+  if (!(maxRate > 0)) maxRate = 1;
+  const clipped = seen > maxRate;
+  const yOf = (r: number): number => Math.max(top, bottom - (r / maxRate) * (bottom - top));
+  ctx.strokeStyle = theme.grid;
+  ctx.lineWidth = 1;
+  ctx.strokeRect(left + 0.5, top + 0.5, w, bottom - top);
+  if (desired > 0) {
+    ctx.setLineDash([4, 3]);
+    ctx.strokeStyle = theme.muted;
+    ctx.beginPath();
+    ctx.moveTo(left, yOf(desired));
+    ctx.lineTo(right, yOf(desired));
+    ctx.stroke();
+    ctx.strokeStyle = colors.lagging;
+    ctx.beginPath();
+    ctx.moveTo(left, yOf(desired * 0.95));
+    ctx.lineTo(right, yOf(desired * 0.95));
+    ctx.stroke();
+    ctx.setLineDash([]);
+    ctx.fillStyle = theme.muted;
+    ctx.fillText(formatValue(desired), left - 4, yOf(desired));
+  }
+  ctx.fillText("0", left - 4, bottom);
+  ctx.strokeStyle = theme.accent;
+  ctx.lineWidth = 1.5;
+  ctx.beginPath();
+  let first = true;
+  h.forEach((t, _s, rate) => {
+    const x = xOf(t);
+    const y = yOf(rate);
+    if (first) ctx.moveTo(x, y);
+    else ctx.lineTo(x, y);
+    first = false;
+  });
+  ctx.stroke();
+  ctx.fillStyle = theme.muted;
+  ctx.textAlign = "left";
+  ctx.fillText(
+    `rate, Hz (dashed: desired and 95 %)${clipped ? `; peaks above ${formatValue(maxRate)} clipped` : ""}`,
+    left + 4,
+    top + 8,
+  );
+  ctx.textAlign = "right";
+  ctx.textBaseline = "top";
+  ctx.fillText("now", right, bottom + 2);
+  ctx.textAlign = "left";
+  ctx.fillText(`−${h.seconds} s`, left, bottom + 2);
+}

@@ -1,0 +1,496 @@
+/**
+ * UI benchmark (issue 5; a benchmark, not a test): the Delsys-like pipeline (32 ch @ 1926 Hz)
+ * runs in the browser build with three scopes open; for 30 s it records the main thread's long
+ * tasks (PerformanceObserver 'longtask': every task over 50 ms, count and longest) and each
+ * scope's redraw rate (uPlot setData calls, counted by the panels in
+ * `window.__mosaicPanelStats`), plus animation frames per second. Targets: no long task over
+ * 50 ms in 30 s; every scope ≥ 30 redraws per second. Prints the figures and writes
+ * bench/results/ui.json and ui.md.
+ *
+ * Run: `npm run bench:ui` (= node scripts/build-ts.mjs && node scripts/build-web.mjs &&
+ * node tests/bench/ui/run.mjs [options]). Options: --mode app|harness (app: the real shell,
+ * panels opened by clicking the graph's nodes [data-block]; harness: the panels alone, see
+ * harness.tsx), --seconds 30, --warmup 5, --pipeline pipelines/bench/delsys.yaml,
+ * --blocks Delsys,LowPass,Resampler, --shots DIR (screenshots of every tab of every panel),
+ * --no-write (print only).
+ */
+import { createReadStream, existsSync, mkdirSync, statSync, writeFileSync } from "node:fs";
+import { createServer, type Server } from "node:http";
+import { cpus, loadavg } from "node:os";
+import { extname, join, normalize, resolve, sep } from "node:path";
+import { chromium, type Browser, type Page } from "playwright-core";
+
+const ROOT = resolve(process.env.MOSAIC_ROOT ?? process.cwd());
+const WEB = join(ROOT, "dist/web");
+const HARNESS = join(ROOT, "dist/bench-ui");
+
+interface Options {
+  mode: "app" | "harness";
+  seconds: number;
+  warmup: number;
+  pipeline: string;
+  blocks: string[];
+  shots: string | undefined;
+  write: boolean;
+  chromium: string;
+}
+
+function parseArgs(argv: string[]): Options {
+  const o: Options = {
+    mode: "app",
+    seconds: 30,
+    warmup: 5,
+    pipeline: "pipelines/bench/delsys.yaml",
+    blocks: ["Delsys", "LowPass", "Resampler"],
+    shots: undefined,
+    write: true,
+    chromium: process.env.CHROMIUM ?? "/usr/bin/chromium",
+  };
+  for (let i = 0; i < argv.length; i++) {
+    const a = argv[i]!;
+    const next = (): string => {
+      const v = argv[++i];
+      if (v === undefined) throw new Error(`${a} needs a value`);
+      return v;
+    };
+    if (a === "--mode") {
+      const m = next();
+      if (m !== "app" && m !== "harness") throw new Error("--mode is app or harness");
+      o.mode = m;
+    } else if (a === "--seconds") o.seconds = Number(next());
+    else if (a === "--warmup") o.warmup = Number(next());
+    else if (a === "--pipeline") o.pipeline = next();
+    else if (a === "--blocks") o.blocks = next().split(",").filter(Boolean);
+    else if (a === "--shots") o.shots = resolve(next());
+    else if (a === "--no-write") o.write = false;
+    else if (a === "--chromium") o.chromium = next();
+    else throw new Error(`unknown option ${a}`);
+  }
+  return o;
+}
+
+const MIME: Record<string, string> = {
+  ".html": "text/html; charset=utf-8",
+  ".js": "text/javascript; charset=utf-8",
+  ".css": "text/css; charset=utf-8",
+  ".json": "application/json",
+  ".map": "application/json",
+  ".wasm": "application/wasm",
+  ".yaml": "text/yaml; charset=utf-8",
+  ".csv": "text/csv; charset=utf-8",
+  ".txt": "text/plain; charset=utf-8",
+};
+
+/** `rel` under `base` when it is a file there (never outside it). */
+function inside(base: string, rel: string): string | undefined {
+  const f = resolve(base, rel);
+  return f.startsWith(base + sep) && existsSync(f) && statSync(f).isFile() ? f : undefined;
+}
+
+/** A static server for the browser build, cross-origin isolated (COOP/COEP) like `npm start`. */
+function serve(): Promise<{ server: Server; url: string }> {
+  const server = createServer((req, res) => {
+    const path = decodeURIComponent(new URL(req.url ?? "/", "http://x").pathname);
+    const rel = normalize(path === "/" ? "/index.html" : path).replace(/^([/\\])+/, "");
+    const file = inside(HARNESS, rel) ?? inside(WEB, rel);
+    if (!file) {
+      res.writeHead(404).end("not found");
+      return;
+    }
+    res.writeHead(200, {
+      "Content-Type": MIME[extname(file)] ?? "application/octet-stream",
+      "Cross-Origin-Opener-Policy": "same-origin",
+      "Cross-Origin-Embedder-Policy": "require-corp",
+      "Cache-Control": "no-store",
+    });
+    createReadStream(file).pipe(res);
+  });
+  return new Promise((ok) =>
+    server.listen(0, "127.0.0.1", () => {
+      const a = server.address();
+      const port = typeof a === "object" && a ? a.port : 0;
+      ok({ server, url: `http://127.0.0.1:${port}/` });
+    }),
+  );
+}
+
+/** Installed before any page script: every long task the main thread runs. */
+const LONGTASK_OBSERVER = `
+  window.__benchLongTasks = [];
+  try {
+    new PerformanceObserver((list) => {
+      for (const e of list.getEntries()) window.__benchLongTasks.push({ start: e.startTime, duration: e.duration });
+    }).observe({ type: "longtask", buffered: true });
+  } catch (e) { window.__benchLongTasksError = String(e); }
+  // Long animation frames (Chrome 123+) say which scripts a long frame ran: for diagnosis.
+  window.__benchLoaf = [];
+  try {
+    new PerformanceObserver((list) => {
+      for (const e of list.getEntries()) {
+        if (e.duration <= 50) continue;
+        window.__benchLoaf.push({
+          start: e.startTime,
+          duration: e.duration,
+          blocking: e.blockingDuration,
+          render: e.renderStart ? e.startTime + e.duration - e.renderStart : 0,
+          layout: e.styleAndLayoutStart ? e.startTime + e.duration - e.styleAndLayoutStart : 0,
+          scripts: (e.scripts || []).map((x) => ({
+            invoker: x.invoker,
+            source: (x.sourceURL || "").split("/").pop() + ":" + x.sourceFunctionName + "@" + x.sourceCharPosition,
+            duration: Math.round(x.duration),
+            forcedLayout: Math.round(x.forcedStyleAndLayoutDuration || 0),
+          })),
+        });
+      }
+    }).observe({ type: "long-animation-frame", buffered: true });
+  } catch (e) { window.__benchLoafError = String(e); }
+`;
+
+interface ViewStats {
+  draws: number;
+  drawMs: number;
+  maxDrawMs: number;
+  messages: number;
+  events: number;
+  skipped: number;
+}
+interface Snapshot {
+  now: number;
+  frames: number;
+  tasks: number;
+  views: Record<string, ViewStats>;
+  longTasks: { start: number; duration: number }[];
+  loaf: LongFrame[];
+}
+
+interface LongFrame {
+  start: number;
+  duration: number;
+  blocking: number;
+  render: number;
+  layout: number;
+  scripts: { invoker: string; source: string; duration: number; forcedLayout: number }[];
+}
+
+const SNAPSHOT = `(() => {
+  const s = window.__mosaicPanelStats ?? { frames: 0, tasks: 0, views: {} };
+  return { now: performance.now(), frames: s.frames, tasks: s.tasks, views: JSON.parse(JSON.stringify(s.views)), longTasks: window.__benchLongTasks ?? [], loaf: window.__benchLoaf ?? [] };
+})()`;
+
+async function snapshot(page: Page): Promise<Snapshot> {
+  return (await page.evaluate(SNAPSHOT)) as Snapshot;
+}
+
+const TELEMETRY = `(() => {
+  const t = window.mosaic?.client?.telemetry;
+  return t ? t.blocks.map((b) => ({ name: b.name, status: b.status, rate: b.rate, desiredRate: b.desiredRate, dropsIn: b.dropsIn, computeMaxMs: b.computeMaxMs })) : [];
+})()`;
+
+async function openPanels(page: Page, o: Options, base: string): Promise<void> {
+  if (o.mode === "harness") {
+    await page.goto(
+      `${base}harness.html?pipeline=${encodeURIComponent(o.pipeline)}&blocks=${o.blocks.join(",")}`,
+    );
+  } else {
+    await page.goto(`${base}?pipeline=${encodeURIComponent(o.pipeline)}`);
+    for (const b of o.blocks) {
+      const node = page.locator(`[data-block="${b}"]`).first();
+      await node.waitFor({ state: "visible", timeout: 30_000 });
+      await node.click();
+    }
+  }
+  for (const b of o.blocks) {
+    try {
+      await page
+        .locator(`[data-view="scope"][data-block="${b}"]`)
+        .first()
+        .waitFor({ state: "visible", timeout: 20_000 });
+    } catch {
+      throw new Error(
+        `no scope of ${b} appeared: ${o.mode === "app" ? "the app shell does not mount BlockPanel (app/ui/panels/block-panel.tsx) yet, or" : ""} the block has no scope view. Try --mode harness.`,
+      );
+    }
+  }
+  // Every scope must be on screen: a panel scrolled out of the dock is not visible and draws nothing.
+  const hidden = (await page.evaluate(
+    `[...document.querySelectorAll("[data-block-panel]")].filter((e) => e.getAttribute("data-visible") !== "true").map((e) => e.getAttribute("data-block-panel"))`,
+  )) as string[];
+  if (hidden.length)
+    console.log(`ui-bench: warning: panels not visible (off screen?): ${hidden.join(", ")}`);
+}
+
+interface Figures {
+  date: string;
+  mode: string;
+  pipeline: string;
+  blocks: string[];
+  seconds: number;
+  chromium: string;
+  host: { cpus: number; load1: number };
+  sharedMemory: boolean;
+  longTasks: { count: number; maxMs: number; totalMs: number; durationsMs: number[] };
+  /** Long animation frames over 50 ms in the window, with the scripts they ran (diagnosis). */
+  longFrames: LongFrame[];
+  frames: { perSecond: number };
+  scopes: {
+    view: string;
+    redrawsPerSecond: number;
+    minPerSecond: number;
+    drawMsMean: number;
+    drawMsMax: number;
+    eventsPerSecond: number;
+    skippedPerSecond: number;
+  }[];
+  afterClose: { tasks: number; messagesInOneSecond: number } | undefined;
+  engine: { name: string; status: string; rate: number; desiredRate: number; dropsIn: number }[];
+  targets: { noLongTask: boolean; scopesAt30fps: boolean };
+}
+
+async function measure(page: Page, o: Options): Promise<Figures> {
+  await page.waitForTimeout(o.warmup * 1000);
+  const start = await snapshot(page);
+  const perSecond: Record<string, number[]> = {};
+  let prev = start;
+  for (let s = 0; s < o.seconds; s++) {
+    await page.waitForTimeout(1000);
+    const cur = await snapshot(page);
+    const dt = (cur.now - prev.now) / 1000;
+    for (const [k, v] of Object.entries(cur.views)) {
+      if (!k.startsWith("scope:")) continue;
+      (perSecond[k] ??= []).push((v.draws - (prev.views[k]?.draws ?? 0)) / dt);
+    }
+    prev = cur;
+  }
+  const end = prev;
+  const elapsed = (end.now - start.now) / 1000;
+  const tasks = end.longTasks.filter((t) => t.start >= start.now && t.start <= end.now);
+  const scopes = Object.entries(end.views)
+    .filter(([k]) => k.startsWith("scope:"))
+    .map(([k, v]) => {
+      const a = start.views[k] ?? {
+        draws: 0,
+        drawMs: 0,
+        maxDrawMs: 0,
+        events: 0,
+        skipped: 0,
+        messages: 0,
+      };
+      const draws = v.draws - a.draws;
+      return {
+        view: k,
+        redrawsPerSecond: round(draws / elapsed, 1),
+        minPerSecond: round(Math.min(...(perSecond[k] ?? [0])), 1),
+        drawMsMean: round(draws ? (v.drawMs - a.drawMs) / draws : 0, 2),
+        drawMsMax: round(v.maxDrawMs, 1),
+        eventsPerSecond: round((v.events - a.events) / elapsed, 0),
+        skippedPerSecond: round((v.skipped - a.skipped) / elapsed, 0),
+      };
+    });
+  const engine = (await page.evaluate(TELEMETRY)) as Figures["engine"];
+  const sharedMemory = (await page.evaluate("self.crossOriginIsolated === true")) as boolean;
+  const longest = tasks.reduce((m, t) => Math.max(m, t.duration), 0);
+  return {
+    date: new Date().toISOString(),
+    mode: o.mode,
+    pipeline: o.pipeline,
+    blocks: o.blocks,
+    seconds: round(elapsed, 1),
+    chromium: o.chromium,
+    host: { cpus: cpus().length, load1: round(loadavg()[0] ?? 0, 2) },
+    sharedMemory,
+    longTasks: {
+      count: tasks.length,
+      maxMs: round(longest, 0),
+      totalMs: round(
+        tasks.reduce((m, t) => m + t.duration, 0),
+        0,
+      ),
+      durationsMs: tasks.map((t) => round(t.duration, 0)),
+    },
+    longFrames: end.loaf
+      .filter((f) => f.start >= start.now && f.start <= end.now)
+      .map((f) => ({
+        ...f,
+        start: round(f.start - start.now, 0),
+        duration: round(f.duration, 0),
+        blocking: round(f.blocking, 0),
+        render: round(f.render, 0),
+        layout: round(f.layout, 0),
+      })),
+    frames: { perSecond: round((end.frames - start.frames) / elapsed, 1) },
+    scopes,
+    afterClose: undefined,
+    engine,
+    targets: {
+      noLongTask: tasks.length === 0,
+      scopesAt30fps:
+        scopes.length === o.blocks.length && scopes.every((s) => s.redrawsPerSecond >= 30),
+    },
+  };
+}
+
+/** Closes (app) or hides (harness) the panels and checks that no draw task nor data remains. */
+async function checkRelease(page: Page, o: Options): Promise<Figures["afterClose"]> {
+  if (o.mode === "harness") await page.locator('[data-harness="close-all"]').click();
+  else {
+    for (const b of o.blocks) {
+      const close = page.locator(`[data-panel="${b}"] button[aria-label^="Close"]`).first();
+      if (await close.count()) await close.click();
+    }
+  }
+  await page.waitForTimeout(500);
+  const a = await snapshot(page);
+  await page.waitForTimeout(1000);
+  const b = await snapshot(page);
+  let messages = 0;
+  for (const [k, v] of Object.entries(b.views))
+    messages += v.messages - (a.views[k]?.messages ?? 0);
+  return { tasks: b.tasks, messagesInOneSecond: messages };
+}
+
+/** Screenshots of every tab of every open panel (to look at them). */
+async function screenshots(page: Page, o: Options, dir: string): Promise<string[]> {
+  mkdirSync(dir, { recursive: true });
+  const files: string[] = [];
+  for (const b of o.blocks) {
+    const panel = page.locator(`[data-block-panel="${b}"]`).first();
+    const tabs = await panel
+      .locator("[role=tab]")
+      .evaluateAll((els) => els.map((e) => e.getAttribute("data-tab") ?? ""));
+    for (const t of tabs) {
+      await panel.locator(`[data-tab="${t}"]`).click();
+      await page.waitForTimeout(t === "status" ? 1500 : 1200);
+      const f = join(dir, `${o.mode}-${b}-${t}.png`);
+      await panel.screenshot({ path: f });
+      files.push(f);
+    }
+    await panel
+      .locator('[data-tab="scope"]')
+      .click()
+      .catch(() => undefined);
+  }
+  const f = join(dir, `${o.mode}-page.png`);
+  await page.screenshot({ path: f });
+  files.push(f);
+  return files;
+}
+
+const round = (x: number, d: number): number => Math.round(x * 10 ** d) / 10 ** d;
+
+function markdown(f: Figures): string {
+  const yes = (b: boolean): string => (b ? "met" : "**missed**");
+  const lines = [
+    "# UI benchmark",
+    "",
+    `${f.date} · ${f.mode === "app" ? "the app shell" : "panels alone (harness)"} · \`${f.pipeline}\` · scopes of ${f.blocks.join(", ")} · ${f.seconds} s measured · Chromium headless (${f.chromium}) · ${f.host.cpus} CPUs, load ${f.host.load1} · shared memory: ${f.sharedMemory ? "yes" : "no"}`,
+    "",
+    "| figure | target | measured | result |",
+    "| --- | --- | --- | --- |",
+    `| main-thread long tasks (> 50 ms) | none | ${f.longTasks.count}${f.longTasks.count ? ` (longest ${f.longTasks.maxMs} ms)` : ""} | ${yes(f.targets.noLongTask)} |`,
+    ...f.scopes.map(
+      (s) =>
+        `| ${s.view} redraws/s (slowest second) | ≥ 30 | ${s.redrawsPerSecond} (${s.minPerSecond}); draw ${s.drawMsMean} ms mean, ${s.drawMsMax} ms max | ${yes(s.redrawsPerSecond >= 30)} |`,
+    ),
+    `| animation frames/s | — | ${f.frames.perSecond} | — |`,
+    "",
+    ...(f.longFrames.length
+      ? [
+          "Long animation frames (> 50 ms) and what ran in them:",
+          "",
+          ...f.longFrames.map(
+            (l) =>
+              `- at ${(l.start / 1000).toFixed(1)} s: ${l.duration} ms (blocking ${l.blocking} ms, rendering ${l.render} ms)` +
+              (l.scripts.length
+                ? `: ${l.scripts.map((x) => `${x.invoker} ${x.source} ${x.duration} ms`).join("; ")}`
+                : ""),
+          ),
+          "",
+        ]
+      : []),
+    "Scope data: " +
+      f.scopes
+        .map(
+          (s) =>
+            `${s.view} ${s.eventsPerSecond} events/s plotted (${s.skippedPerSecond}/s left out by the engine's maxRate)`,
+        )
+        .join("; ") +
+      ".",
+    "",
+    f.afterClose
+      ? `After closing the panels: ${f.afterClose.tasks} draw tasks left, ${f.afterClose.messagesInOneSecond} data messages in the next second.`
+      : "",
+    "",
+    "Engine at the end: " +
+      f.engine
+        .map(
+          (b) =>
+            `${b.name} ${b.status} ${round(b.rate, 1)}/${round(b.desiredRate, 1)} Hz${b.dropsIn ? `, ${b.dropsIn} dropped` : ""}`,
+        )
+        .join("; "),
+    "",
+  ];
+  return lines.join("\n");
+}
+
+async function main(): Promise<void> {
+  const o = parseArgs(process.argv.slice(2));
+  if (!existsSync(join(WEB, "index.html")))
+    throw new Error("dist/web is missing: run node scripts/build-web.mjs first");
+  if (o.mode === "harness" && !existsSync(join(HARNESS, "harness.html")))
+    throw new Error(
+      "dist/bench-ui is missing: run node tests/bench/ui/run.mjs (it builds the harness)",
+    );
+  const { server, url } = await serve();
+  let browser: Browser | undefined;
+  try {
+    browser = await chromium.launch({
+      executablePath: o.chromium,
+      args: [
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-quic",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+      ],
+    });
+    // Tall enough for three docked panels to be on screen at once.
+    const page = await browser.newPage({
+      viewport: { width: 1600, height: o.mode === "app" ? 1500 : 1000 },
+    });
+    const errors: string[] = [];
+    page.on("pageerror", (e) => errors.push(String(e)));
+    page.on("console", (m) => {
+      if (m.type() === "error") errors.push(m.text());
+    });
+    await page.addInitScript(LONGTASK_OBSERVER);
+    console.log(`ui-bench: ${o.mode} mode, ${url}, opening scopes of ${o.blocks.join(", ")}`);
+    await openPanels(page, o, url);
+    const f = await measure(page, o);
+    if (o.shots) {
+      const files = await screenshots(page, o, o.shots);
+      console.log(`ui-bench: ${files.length} screenshots in ${o.shots}`);
+    }
+    f.afterClose = await checkRelease(page, o);
+    const md = markdown(f);
+    console.log(md);
+    if (errors.length) console.log(`page errors:\n  ${errors.slice(0, 10).join("\n  ")}`);
+    if (o.write) {
+      const dir = join(ROOT, "bench/results");
+      mkdirSync(dir, { recursive: true });
+      writeFileSync(join(dir, "ui.json"), JSON.stringify(f, null, 2) + "\n");
+      writeFileSync(join(dir, "ui.md"), md);
+      console.log("ui-bench: wrote bench/results/ui.json and ui.md");
+    }
+  } finally {
+    await browser?.close();
+    server.close();
+  }
+}
+
+main().catch((e: unknown) => {
+  console.error(`ui-bench: ${e instanceof Error ? e.message : String(e)}`);
+  process.exitCode = 1;
+});

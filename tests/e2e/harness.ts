@@ -1,0 +1,162 @@
+/**
+ * End-to-end harness: the built browser app (dist/web) served by the product's own static server
+ * (with the COOP/COEP headers), and Debian's Chromium driven by playwright-core.
+ *
+ * The served root is a temporary folder that links every entry of dist/web and adds `e2e/` with
+ * the test pipelines of ./fixtures, so the build folder itself is never written.
+ */
+import { execFileSync } from "node:child_process";
+import {
+  cpSync,
+  existsSync,
+  mkdirSync,
+  mkdtempSync,
+  readdirSync,
+  rmSync,
+  statSync,
+  symlinkSync,
+} from "node:fs";
+import { tmpdir } from "node:os";
+import { dirname, join, resolve } from "node:path";
+import { fileURLToPath } from "node:url";
+import { chromium, type BrowserContext, type Page } from "playwright-core";
+import { serveStatic, type WebServer } from "../../app/host/web-server";
+
+export const ROOT = resolve(dirname(fileURLToPath(import.meta.url)), "../..");
+export const WEB = join(ROOT, "dist/web");
+export const ARTIFACTS = join(ROOT, "tests/e2e/artifacts");
+export const CHROMIUM = process.env.MOSAIC_CHROMIUM ?? "/usr/bin/chromium";
+export const haveChromium = existsSync(CHROMIUM);
+
+const SOURCES = [
+  "app/ui",
+  "app/web",
+  "app/engine",
+  "app/blocks",
+  "scripts/build-web.mjs",
+  "pipelines",
+];
+
+function newest(path: string): number {
+  const s = statSync(path);
+  if (!s.isDirectory()) return s.mtimeMs;
+  let t = s.mtimeMs;
+  for (const e of readdirSync(path)) t = Math.max(t, newest(join(path, e)));
+  return t;
+}
+
+/** Builds dist/web when it is missing or older than its sources. */
+export function ensureWebBuild(): void {
+  const app = join(WEB, "app.js");
+  const stale =
+    !existsSync(app) ||
+    SOURCES.some((s) => existsSync(join(ROOT, s)) && newest(join(ROOT, s)) > statSync(app).mtimeMs);
+  if (stale)
+    execFileSync(process.execPath, ["scripts/build-web.mjs"], { cwd: ROOT, stdio: "inherit" });
+}
+
+export interface Served {
+  url: string;
+  root: string;
+  close(): Promise<void>;
+}
+
+/** Serves dist/web plus the e2e fixtures under `e2e/`. */
+export async function serveApp(): Promise<Served> {
+  ensureWebBuild();
+  const root = mkdtempSync(join(tmpdir(), "mosaic-e2e-web-"));
+  for (const e of readdirSync(WEB)) symlinkSync(join(WEB, e), join(root, e));
+  mkdirSync(join(root, "e2e"));
+  cpSync(join(ROOT, "tests/e2e/fixtures"), join(root, "e2e"), { recursive: true });
+  const server: WebServer = await serveStatic(root, 0);
+  return {
+    url: server.url,
+    root,
+    async close() {
+      await server.close();
+      rmSync(root, { recursive: true, force: true });
+    },
+  };
+}
+
+export interface Chromium {
+  context: BrowserContext;
+  close(): Promise<void>;
+}
+
+/** Debian's Chromium, headless, with a fresh profile in a temporary folder. */
+export async function launchChromium(): Promise<Chromium> {
+  const profile = mkdtempSync(join(tmpdir(), "mosaic-e2e-profile-"));
+  const context = await chromium.launchPersistentContext(profile, {
+    executablePath: CHROMIUM,
+    headless: true,
+    args: [
+      "--headless",
+      "--no-sandbox",
+      "--disable-gpu",
+      "--disable-quic",
+      "--no-first-run",
+      "--disable-background-networking",
+      "--disable-component-update",
+      "--disable-sync",
+    ],
+    viewport: { width: 1440, height: 900 },
+    acceptDownloads: true,
+  });
+  return {
+    context,
+    async close() {
+      await context.close();
+      rmSync(profile, { recursive: true, force: true });
+    },
+  };
+}
+
+export interface AppPage {
+  page: Page;
+  /** Errors the page reported (uncaught exceptions, console.error). */
+  errors: string[];
+  close(): Promise<void>;
+}
+
+/** Opens the app on `pipeline` (default: the demo) in a new tab and waits until it runs. */
+export async function openApp(
+  browser: Chromium,
+  base: string,
+  pipeline?: string,
+  opts: {
+    reducedMotion?: boolean;
+    waitRunning?: boolean;
+    /** A script run in the page before its own (e.g. observers that time what happens). */
+    initScript?: string;
+  } = {},
+): Promise<AppPage> {
+  const page = await browser.context.newPage();
+  if (opts.initScript !== undefined) await page.addInitScript(opts.initScript);
+  await page.emulateMedia({ reducedMotion: opts.reducedMotion ? "reduce" : "no-preference" });
+  const errors: string[] = [];
+  page.on("pageerror", (e) => errors.push(`pageerror: ${e.message}`));
+  page.on("console", (m) => {
+    if (m.type() === "error") errors.push(`console: ${m.text()}`);
+  });
+  const url = pipeline ? `${base}?pipeline=${encodeURIComponent(pipeline)}` : base;
+  await page.goto(url);
+  if (opts.waitRunning !== false) {
+    await page.waitForSelector('.app[data-engine-state="running"]', { timeout: 15_000 });
+  }
+  return { page, errors, close: () => page.close() };
+}
+
+export function artifact(name: string): string {
+  mkdirSync(ARTIFACTS, { recursive: true });
+  return join(ARTIFACTS, name);
+}
+
+/** Statuses of every node, by block name. */
+export async function statuses(page: Page): Promise<Record<string, string>> {
+  return page.$$eval("[data-block][data-status]", (els) =>
+    Object.fromEntries(
+      els.map((e) => [e.getAttribute("data-block"), e.getAttribute("data-status")]),
+    ),
+  );
+}
