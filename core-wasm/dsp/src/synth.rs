@@ -100,12 +100,26 @@ struct Channel {
     hp: [f64; 2],
     lp: [f64; 2],
     env: f64,
-    /// Constant per-channel parameters drawn from the channel's generator.
-    hum_phase: f64,
+    /// Constant per-channel parameters drawn from the channel's generator:
+    /// the hum's phase as (sin ψ, cos ψ) so that the hum needs no `sin` per
+    /// channel, the modulation's phase and rate (cycles per sample).
+    hum_sin: f64,
+    hum_cos: f64,
     mod_phase: f64,
-    /// Modulation rate in cycles per sample.
     mod_rate: f64,
+    /// sin/cos of one sample's modulation phase step (a rotation).
+    step_sin: f64,
+    step_cos: f64,
+    /// sin/cos of the modulation phase at the current sample: advanced by the
+    /// rotation every sample, recomputed exactly every `RESYNC` samples (so
+    /// rounding never accumulates and the output does not depend on how the
+    /// samples are split into calls).
+    mod_sin: f64,
+    mod_cos: f64,
 }
+
+/// Samples between exact recomputations of the modulation phasor.
+const RESYNC: u64 = 1024;
 
 /// A seeded, multi-channel surface-EMG generator (the *EmgSimulator* block).
 ///
@@ -211,14 +225,20 @@ impl EmgSynth {
                 let hum_phase = TAU * rng.uniform();
                 let mod_phase = TAU * rng.uniform();
                 let mod_hz = 1.0 + 2.0 * rng.uniform();
+                let mod_rate = mod_hz / fs;
                 Channel {
                     rng,
                     hp: [0.0; 2],
                     lp: [0.0; 2],
                     env: 0.0,
-                    hum_phase,
+                    hum_sin: hum_phase.sin(),
+                    hum_cos: hum_phase.cos(),
                     mod_phase,
-                    mod_rate: mod_hz / fs,
+                    mod_rate,
+                    step_sin: (TAU * mod_rate).sin(),
+                    step_cos: (TAU * mod_rate).cos(),
+                    mod_sin: mod_phase.sin(),
+                    mod_cos: mod_phase.cos(),
                 }
             })
             .collect();
@@ -373,7 +393,9 @@ impl EmgSynth {
         let depth = self.config.modulation;
         for row in out.chunks_exact_mut(c) {
             let t = self.n as f64;
-            let hum_cycles = fract(t * self.hum_rate);
+            let resync = self.n % RESYNC == 0;
+            // sin(a + ψ) = sin a · cos ψ + cos a · sin ψ: one sin/cos per sample for all channels.
+            let (hum_sin, hum_cos) = (TAU * fract(t * self.hum_rate)).sin_cos();
             for ((y, ch), &target) in row.iter_mut().zip(&mut self.channels).zip(&self.targets) {
                 let w1 = ch.rng.gaussian();
                 let w2 = ch.rng.gaussian();
@@ -388,10 +410,19 @@ impl EmgSynth {
                     self.alpha_release
                 };
                 ch.env += alpha * (target - ch.env);
-                let modulation = 1.0 + depth * (TAU * fract(t * ch.mod_rate) + ch.mod_phase).sin();
+                if resync {
+                    let (s, c) = (TAU * fract(t * ch.mod_rate) + ch.mod_phase).sin_cos();
+                    ch.mod_sin = s;
+                    ch.mod_cos = c;
+                }
+                let modulation = 1.0 + depth * ch.mod_sin;
                 *y = self.emg_gain * band * ch.env * modulation
                     + noise * w2
-                    + hum * (TAU * hum_cycles + ch.hum_phase).sin();
+                    + hum * (hum_sin * ch.hum_cos + hum_cos * ch.hum_sin);
+                // Advance the modulation phasor by one sample.
+                let (s, c) = (ch.mod_sin, ch.mod_cos);
+                ch.mod_sin = s * ch.step_cos + c * ch.step_sin;
+                ch.mod_cos = c * ch.step_cos - s * ch.step_sin;
             }
             self.n += 1;
         }
@@ -512,6 +543,24 @@ fn validate(c: &EmgSynthConfig) -> Result<(), DspError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn modulation_phasor_tracks_the_exact_phase() {
+        let mut s = EmgSynth::new(EmgSynthConfig::new(3, 2048.0, 4)).unwrap();
+        let mut out = vec![0.0; 3 * 1023];
+        let mut worst: f64 = 0.0;
+        for _ in 0..20 {
+            s.generate(&mut out).unwrap();
+            let t = s.n as f64;
+            for ch in &s.channels {
+                let exact = TAU * fract(t * ch.mod_rate) + ch.mod_phase;
+                worst = worst
+                    .max((ch.mod_sin - exact.sin()).abs())
+                    .max((ch.mod_cos - exact.cos()).abs());
+            }
+        }
+        assert!(worst < 1e-12, "phasor error {worst}");
+    }
 
     #[test]
     fn impulse_energy_of_identity_lowpass_is_positive() {
