@@ -24,6 +24,9 @@ import { SlidingWindow } from "./flow/sliding-window";
 import { Splitter } from "./flow/splitter";
 import { Switch } from "./flow/switch";
 import { VectorialFunction } from "./flow/vectorial-function";
+import { SerialPort } from "./io/serial-port";
+import { UdpReceiver } from "./io/udp-receiver";
+import { UdpSender } from "./io/udp-sender";
 import { BatchPredictor } from "./learning/batch-predictor";
 import { IncrementalPredictor } from "./learning/incremental-predictor";
 import { Stimulus } from "./learning/stimulus";
@@ -90,6 +93,10 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   IncrementalPredictor,
   // Control
   ControlAlgorithm,
+  // Communication
+  UdpSender,
+  UdpReceiver,
+  SerialPort,
   // Recording
   Logger,
   // Testing

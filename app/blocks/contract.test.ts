@@ -32,6 +32,7 @@ import {
   type AnyBlockDefinition,
   type BlockContext,
   type BlockInstance,
+  type IoBridges,
   type Resources,
   type Shape,
 } from "../engine";
@@ -70,6 +71,55 @@ interface Setup {
    * so that the entry is removed when the block is fixed.
    */
   known?: { pattern: RegExp; reason: string }[];
+  /** Fake I/O bridges for the block; what they recorded (e.g. datagrams sent) joins the snapshot. */
+  io?: () => FakeIo;
+}
+
+interface FakeIo {
+  io: IoBridges;
+  recorded(): unknown;
+  clear(): void;
+}
+
+/** A UDP bridge that keeps every datagram sent (as hex), instead of a socket. */
+function recordingUdp(): FakeIo {
+  const sent: string[] = [];
+  return {
+    io: {
+      udp: {
+        open: () => ({
+          send: (data) => sent.push(Buffer.from(data).toString("hex")),
+          close: () => {},
+        }),
+      },
+    },
+    recorded: () => [...sent],
+    clear: () => (sent.length = 0),
+  };
+}
+
+/** A serial device that echoes every byte written to it (a loopback plug); writes are recorded. */
+function loopbackSerial(): FakeIo {
+  const written: string[] = [];
+  return {
+    io: {
+      serial: {
+        open: (o) => {
+          o.onStatus("open");
+          return {
+            write: (data) => {
+              written.push(Buffer.from(data).toString("hex"));
+              o.onData(data);
+            },
+            close: () => o.onStatus("closed"),
+          };
+        },
+        list: async () => [],
+      },
+    },
+    recorded: () => [...written],
+    clear: () => (written.length = 0),
+  };
 }
 
 const timer = (rate: number): InputSetup => ({ shape: EMPTY_SHAPE, rate, isTimer: true });
@@ -239,6 +289,35 @@ const SETUPS: Record<string, Setup | Setup[]> = {
     params: { Strategy: "stepwise", SlewRate: 50, Timeout: 0 },
     inputs: [vec(3)],
   },
+  UdpSender: [
+    { params: { Port: 9 }, inputs: [vec(3)], io: recordingUdp },
+    {
+      params: { Port: 9, Serializer: "control", Subcategories: [0, 8, 10] },
+      inputs: [vec(3)],
+      io: recordingUdp,
+    },
+    {
+      params: { Port: 9, Serializer: "myo", Timestamp: "event" },
+      inputs: [vec(4)],
+      io: recordingUdp,
+    },
+    { params: { Host: "::1", Port: 9, Format: "f32" }, inputs: [mat(2, 2)], io: recordingUdp },
+  ],
+  // A source fed by its socket: nothing to feed here (tests/integration/udp.test.ts runs it).
+  UdpReceiver: { params: { Port: 9, Channels: 3 }, inputs: [] },
+  SerialPort: [
+    { params: { Path: "/dev/ttyUSB0", Channels: 3 }, inputs: [] },
+    {
+      params: { Path: "/dev/ttyUSB0", Framing: "binary", Fields: ["i16", "f32"], Sync: [170, 85] },
+      inputs: [vec(2)],
+      io: loopbackSerial,
+    },
+    {
+      params: { Path: "COM3", Channels: 2, Checksum: "none" },
+      inputs: [vec(2)],
+      io: loopbackSerial,
+    },
+  ],
   // Setups that end idle (no capture or trial in progress): `reset` would send the stop.
   Trigger: {
     params: {
@@ -430,20 +509,28 @@ function snapshot(h: BlockHarness): Record<string, { t: number[]; v: number[][] 
   const s: Record<string, { t: number[]; v: number[][] } | string[]> = {};
   for (const [name, r] of h.out) s[`port:${name}`] = { t: [...r.t], v: r.v.map((x) => [...x]) };
   for (const [name, lines] of h.logs.files) s[`log:${name}`] = [...lines];
+  const io = fakeIo.get(h);
+  if (io) s.io = io.recorded() as string[];
   return s;
 }
 
 function clearAll(h: BlockHarness): void {
   h.clear();
   for (const lines of h.logs.files.values()) lines.length = 0;
+  fakeIo.get(h)?.clear();
 }
 
+const fakeIo = new WeakMap<BlockHarness, FakeIo>();
+
 async function harness(def: AnyBlockDefinition, s: Setup): Promise<BlockHarness> {
+  const io = s.io?.();
   const h = await BlockHarness.create(def, s.params, {
     inputs: s.inputs,
     now: 0,
     ...(s.resources ? { resources: s.resources } : {}),
+    ...(io ? { io: io.io } : {}),
   });
+  if (io) fakeIo.set(h, io);
   h.start();
   return h;
 }

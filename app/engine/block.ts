@@ -43,6 +43,8 @@ export interface InputInfo {
   readonly source: string;
   readonly block: string;
   readonly port: string;
+  /** The source block's type (canonical name, e.g. "ControlAlgorithm"); undefined when unknown. */
+  readonly type?: string;
   /** The source's output shape; null only inside a feedback cycle whose source is created later. */
   readonly shape: Shape | null;
   /** The source's desired rate in Hz; 0 when aperiodic or unknown. */

@@ -46,8 +46,13 @@ export interface SerialHandle {
 }
 
 export interface SerialBridge {
+  /**
+   * Opens the port and keeps it open: after a failed open or an unplug the bridge reports
+   * `error` (with the reason) and retries every `reconnectMs` (0: never) until `close`.
+   */
   open(
     options: SerialOptions & {
+      reconnectMs: number;
       onData: (data: Uint8Array) => void;
       onStatus: (status: SerialStatus, message?: string) => void;
     },

@@ -109,7 +109,14 @@ export async function runVirtualPipeline(
 }
 
 export interface HarnessOptions {
-  inputs?: { shape: Shape | null; rate?: number; isTimer?: boolean; subscribed?: boolean }[];
+  inputs?: {
+    shape: Shape | null;
+    rate?: number;
+    isTimer?: boolean;
+    subscribed?: boolean;
+    /** The source block's type (as `InputInfo.type`). */
+    type?: string;
+  }[];
   desiredRate?: number;
   now?: number;
   resources?: Resources;
@@ -168,6 +175,7 @@ export class BlockHarness {
       source: `in${index}`,
       block: `in${index}`,
       port: "out",
+      ...(i.type === undefined ? {} : { type: i.type }),
       shape: i.shape,
       rate: i.rate ?? 0,
       isTimer: i.isTimer ?? false,

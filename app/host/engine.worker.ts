@@ -17,6 +17,8 @@ import { Runtime } from "../engine/runtime/runtime";
 import { SabRing } from "../engine/runtime/sab-ring";
 import { runVirtual } from "../engine/runtime/virtual";
 import { RealtimeLoop } from "../engine/runtime/loop";
+import { serialProxy } from "../../native-bridges/serial-proxy";
+import { nodeUdpBridge } from "../../native-bridges/udp";
 import { nodeResources } from "./resources";
 import { clockFromBase } from "./time-base";
 import type { HostToWorker, InitMessage, WorkerToHost } from "./worker-protocol";
@@ -98,6 +100,7 @@ async function create(msg: InitMessage): Promise<void> {
     clock,
     virtual,
     resources: nodeResources(dirname(msg.file)),
+    io: { udp: nodeUdpBridge(), serial: serial.bridge },
     logs: sabLogSink(virtual),
     worker: msg.worker,
     ...(msg.plan ? { plan: msg.plan } : {}),
@@ -190,9 +193,15 @@ function stop(): void {
   }
 }
 
+/** Serial ports are opened by the host's main thread (see native-bridges/serial-proxy.ts). */
+const serial = serialProxy((m) => post(m));
+
 port.on("message", (msg: HostToWorker) => {
   try {
     switch (msg.type) {
+      case "serial":
+        serial.receive(msg);
+        break;
       case "init":
         void create(msg).catch((e: unknown) => post({ type: "fatal", message: errorMessage(e) }));
         break;

@@ -12,6 +12,7 @@ import { errorMessage, type Diagnostic } from "../engine/diagnostics";
 import { shapeSize } from "../engine/frame";
 import type { Plan, RuntimeEvent, Telemetry } from "../engine/runtime/runtime";
 import { SabRing } from "../engine/runtime/sab-ring";
+import { serialHub } from "../../native-bridges/serial-proxy";
 import { LogWriter } from "./log-writer";
 import { takeTimeBase } from "./time-base";
 import type { ClockMode, ControlOp, HostToWorker, WorkerToHost } from "./worker-protocol";
@@ -88,6 +89,8 @@ interface WorkerState {
   stopped: boolean;
   exited: boolean;
   waiters: ((m: WorkerToHost) => boolean)[];
+  /** The worker's serial ports, opened here (created on first use). */
+  serial?: ReturnType<typeof serialHub>;
 }
 
 export interface LoadOutcome {
@@ -238,6 +241,7 @@ export class Host {
     });
     worker.on("exit", (code) => {
       st.exited = true;
+      st.serial?.closeAll();
       if (!st.stopped && code !== 0)
         this.events.fatal?.(`engine worker '${name}' exited with code ${code}`);
       for (const w of st.waiters.splice(0))
@@ -312,6 +316,12 @@ export class Host {
       }
       case "fatal":
         this.events.fatal?.(`engine worker '${st.name}': ${m.message}`);
+        break;
+      case "serial":
+        st.serial ??= serialHub((r) => {
+          if (!st.exited) this.post(st, r);
+        });
+        st.serial.receive(m);
         break;
       default:
         break;
@@ -423,6 +433,7 @@ export class Host {
     await Promise.all(
       [...this.workers.values()].map(async (w) => {
         w.stopped = true;
+        w.serial?.closeAll();
         if (!w.exited) await w.worker.terminate();
       }),
     );

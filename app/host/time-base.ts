@@ -13,6 +13,9 @@ export interface TimeBase {
 }
 
 export function takeTimeBase(): TimeBase {
+  // The first use of `performance` loads perf_hooks (1–3 ms): do it before taking the pair, or
+  // the clock runs that much ahead of wall time.
+  performance.now();
   const mono = process.hrtime.bigint();
   const wallMs = performance.timeOrigin + performance.now();
   return { wallMs, monoNs: mono.toString() };
@@ -20,6 +23,7 @@ export function takeTimeBase(): TimeBase {
 
 /** A clock for this thread that agrees with every other thread given the same base. */
 export function clockFromBase(base: TimeBase): MonotonicClock {
+  performance.now();
   const p = performance.now();
   const mono = process.hrtime.bigint();
   const offsetMs = base.wallMs + Number(mono - BigInt(base.monoNs)) / 1e6 - p;

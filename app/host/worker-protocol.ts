@@ -3,6 +3,7 @@ import type { Diagnostic } from "../engine/diagnostics";
 import type { Shape } from "../engine/frame";
 import type { Plan, Telemetry } from "../engine/runtime/runtime";
 import type { SabRingInit } from "../engine/runtime/sab-ring";
+import type { SerialReply, SerialRequest } from "../../native-bridges/serial-proxy";
 import type { TimeBase } from "./time-base";
 
 export type ClockMode = "realtime" | "virtual";
@@ -40,7 +41,8 @@ export type HostToWorker =
   | LinkMessage
   | { type: "start" }
   | { type: "stop" }
-  | ({ type: "control"; id: number } & ControlOp);
+  | ({ type: "control"; id: number } & ControlOp)
+  | SerialReply;
 
 export type WorkerToHost =
   | { type: "created"; plan: Plan; diagnostics: Diagnostic[]; doorbell: SharedArrayBuffer }
@@ -60,4 +62,5 @@ export type WorkerToHost =
   | { type: "reply"; id: number; ok: boolean; message: string }
   | { type: "finished"; telemetry: Telemetry }
   | { type: "stopped"; telemetry: Telemetry }
-  | { type: "fatal"; message: string };
+  | { type: "fatal"; message: string }
+  | SerialRequest;

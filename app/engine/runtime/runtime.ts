@@ -256,6 +256,7 @@ class Node {
 /** A block placed on another worker: known only through the plan. */
 interface Ghost {
   name: string;
+  type: string;
   worker: string;
   desiredRate: number;
   isTimer: boolean;
@@ -355,6 +356,7 @@ export class Runtime {
       for (const p of opts.plan.blocks) {
         ghosts.set(p.name, {
           name: p.name,
+          type: p.type,
           worker: p.worker,
           desiredRate: p.desiredRate,
           isTimer: p.isTimer,
@@ -379,6 +381,9 @@ export class Runtime {
           source: inp.source,
           block: inp.block,
           port: inp.port,
+          ...((src?.def.type ?? ghost?.type) !== undefined
+            ? { type: src?.def.type ?? ghost?.type }
+            : {}),
           shape,
           rate: src ? src.desiredRate : (ghost?.desiredRate ?? 0),
           isTimer: src ? src.def.timer === true : (ghost?.isTimer ?? false),
@@ -443,6 +448,7 @@ export class Runtime {
         if (rt.byName.has(p.name)) continue;
         ghosts.set(p.name, {
           name: p.name,
+          type: p.type,
           worker: p.worker,
           desiredRate: p.desiredRate,
           isTimer: p.isTimer,

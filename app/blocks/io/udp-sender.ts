@@ -1,0 +1,340 @@
+import { z } from "zod";
+import {
+  BlockConfigError,
+  defineBlock,
+  LegacyParamsError,
+  legacyInteger,
+  type InputInfo,
+  type UdpSocketHandle,
+} from "../../engine";
+import { signalInput } from "../shared/inputs";
+import { plural, TextThrottle } from "../shared/text";
+import {
+  MAX_DATAGRAM_BYTES,
+  MAX_STREAMLINED_VALUES,
+  RawEncoder,
+  StreamlinedEncoder,
+  valueSize,
+  type ValueType,
+} from "./udp-format";
+import {
+  byteParam,
+  endpointText,
+  formatParam,
+  hostParam,
+  portParam,
+  udpBridge,
+  WarnLimiter,
+} from "./udp-common";
+
+/** Value types the sender writes (64-bit integers are read by the receiver, not written). */
+const SEND_TYPES = ["f64", "f32", "i8", "i16", "i32", "u8", "u16", "u32"] as const;
+
+export type Serializer = "vector" | "control" | "myo";
+
+/**
+ * MOSAIC picked the serializer from the type of the block feeding the sender: ControlAlgorithm →
+ * one datagram per degree of actuation, Myo → the vector as scaled signed bytes; anything else
+ * had no serializer (MOSAIC sent nothing), here the whole vector in one datagram.
+ */
+export function serializerFor(sourceType: string | undefined): Serializer {
+  if (sourceType === "ControlAlgorithm") return "control";
+  if (sourceType !== undefined && /^Myo/.test(sourceType)) return "myo";
+  return "vector";
+}
+
+/** The type of the block behind an input, as the engine reports it. */
+function sourceTypeOf(info: InputInfo): string | undefined {
+  return info.type;
+}
+
+const params = z.strictObject({
+  Host: hostParam("Destination: an IP address or host name (default 127.0.0.1)"),
+  Port: portParam("Destination UDP port"),
+  Format: formatParam,
+  Serializer: z
+    .enum(["auto", "vector", "control", "myo"])
+    .default("auto")
+    .describe(
+      "Streamlined only. vector: each event in one datagram; control: one datagram per value " +
+        "(count 1, f64, subcategory = the value's degree of actuation), as MOSAIC sent a " +
+        "ControlAlgorithm's output; myo: the vector as signed bytes (value · 128, category 1, " +
+        "subcategory 1), as MOSAIC sent a Myo's; auto: by the type of the input block, as MOSAIC " +
+        "chose (ControlAlgorithm → control, Myo → myo, otherwise vector)",
+    ),
+  ValueType: z
+    .enum(SEND_TYPES)
+    .optional()
+    .describe(
+      "Streamlined only: type of the values on the wire (default f64; i8 for myo). Integers " +
+        "are rounded and saturated at their range; NaN becomes 0",
+    ),
+  Category: byteParam(
+    "Streamlined only: category byte (default 0 for vector, 1 for control and myo; MOSAIC: 0 EMG, 1 position control, 2 FMG)",
+  ).optional(),
+  Subcategory: byteParam(
+    "Streamlined only: subcategory byte (default 0; 1 for myo); for control, the subcategory of the first value (value k gets Subcategory + k)",
+  ).optional(),
+  Subcategories: z
+    .array(byteParam("subcategory"))
+    .min(1)
+    .max(MAX_STREAMLINED_VALUES)
+    .optional()
+    .describe(
+      "Control only: the subcategory of each value (one per input value), e.g. MOSAIC's DOAs " +
+        "enum values (0 ThumbFlexion … 8 WristPronationSupination, 10 ElbowFlexion, 11 ElbowExtension)",
+    ),
+  Scale: z
+    .number()
+    .optional()
+    .describe("Values are multiplied by this before they are written (default 1; 128 for myo)"),
+  Timestamp: z
+    .enum(["event", "send"])
+    .default("event")
+    .describe(
+      "Streamlined only: the timestamp written, the event's (pipeline clock, reproducible) or the " +
+        "clock time at sending (what MOSAIC wrote)",
+    ),
+});
+
+type Params = z.output<typeof params>;
+
+interface Plan {
+  serializer: Serializer;
+  type: ValueType;
+  category: number;
+  subcategories: number[];
+  scale: number;
+}
+
+function plan(p: Params, size: number, sourceType: string | undefined): Plan {
+  const streamlinedOnly = ["Serializer", "ValueType", "Category", "Subcategory", "Subcategories"];
+  if (p.Format !== "streamlined") {
+    for (const k of streamlinedOnly) {
+      const v = p[k as keyof Params];
+      if (v !== undefined && !(k === "Serializer" && (v === "auto" || v === "vector"))) {
+        throw new BlockConfigError(
+          `${k} applies to the streamlined format; Format ${p.Format} sends bare ${p.Format} vectors`,
+          k,
+        );
+      }
+    }
+    const bytes = size * valueSize(p.Format);
+    if (bytes > MAX_DATAGRAM_BYTES) {
+      throw new BlockConfigError(
+        `the input has ${size} values (${bytes} bytes as ${p.Format}), more than one UDP ` +
+          `datagram holds (${MAX_DATAGRAM_BYTES} bytes)`,
+        "Format",
+      );
+    }
+    return {
+      serializer: "vector",
+      type: p.Format,
+      category: 0,
+      subcategories: [],
+      scale: p.Scale ?? 1,
+    };
+  }
+  const serializer = p.Serializer === "auto" ? serializerFor(sourceType) : p.Serializer;
+  if (serializer !== "control" && p.Subcategories !== undefined) {
+    throw new BlockConfigError(
+      `Subcategories applies to the control serializer (one datagram per value); the ${serializer} serializer sends one datagram per event: use Subcategory`,
+      "Subcategories",
+    );
+  }
+  if (serializer === "control") {
+    let subs: number[];
+    if (p.Subcategories !== undefined) {
+      if (p.Subcategories.length !== size) {
+        throw new BlockConfigError(
+          `Subcategories lists ${p.Subcategories.length} values but the input has ${size}: give one per value`,
+          "Subcategories",
+        );
+      }
+      subs = p.Subcategories;
+    } else {
+      const first = p.Subcategory ?? 0;
+      if (first + size - 1 > 255) {
+        throw new BlockConfigError(
+          `values 0…${size - 1} get subcategories ${first}…${first + size - 1}, past 255 (one byte): lower Subcategory or give Subcategories`,
+          "Subcategory",
+        );
+      }
+      subs = Array.from({ length: size }, (_, k) => first + k);
+    }
+    return {
+      serializer,
+      type: p.ValueType ?? "f64",
+      category: p.Category ?? 1,
+      subcategories: subs,
+      scale: p.Scale ?? 1,
+    };
+  }
+  if (size > MAX_STREAMLINED_VALUES) {
+    throw new BlockConfigError(
+      `the input has ${size} values; a streamlined datagram holds at most ${MAX_STREAMLINED_VALUES} ` +
+        "(its count is one byte): use Format f32 or f64, or select fewer channels",
+      "Format",
+    );
+  }
+  const myo = serializer === "myo";
+  return {
+    serializer,
+    type: p.ValueType ?? (myo ? "i8" : "f64"),
+    category: p.Category ?? (myo ? 1 : 0),
+    subcategories: [p.Subcategory ?? (myo ? 1 : 0)],
+    scale: p.Scale ?? (myo ? 128 : 1),
+  };
+}
+
+export const UdpSender = defineBlock({
+  type: "UdpSender",
+  aliases: ["UDP_StreamlinedSender"],
+  category: "Communication",
+  summary: "Sends each input event as a UDP datagram: MOSAIC's streamlined format or raw vectors.",
+  help:
+    "Sends its input to a device, simulator or game engine over UDP (paper III-I, " +
+    "UDP_StreamlinedSender). In the **streamlined** format (the default) every datagram is " +
+    "`| count | type byte | category | subcategory | f64 timestamp | values | u16 counter |`, " +
+    "little-endian, the counter counting every datagram this block sent (wrapping at 65535); " +
+    "see docs/protocols.md. As in MOSAIC the serializer follows the input block's type: a " +
+    "ControlAlgorithm's output goes as one datagram per degree of actuation (count 1, f64, " +
+    "category 1, subcategory = the DoF), a Myo's as signed bytes (value · 128, category 1, " +
+    "subcategory 1); anything else as one datagram per event with the declared Category and " +
+    "Subcategory. `Serializer` overrides the choice, and the status names the serializer in " +
+    "use. Formats **f32** and **f64** send bare " +
+    "little-endian vectors, for peers that expect plain arrays. Nothing is sent in the browser " +
+    "build (no sockets; the status says so); send errors (e.g. nothing listening) are counted " +
+    "and shown, never fatal. MOSAIC's positional form is `[hostIP, port]`.",
+  params,
+  legacyParams(args) {
+    if (args.length < 2) {
+      throw new LegacyParamsError(
+        `expected at least 2 arguments [hostIP, port] (as MOSAIC's UDP_StreamlinedSender), got ${args.length}`,
+      );
+    }
+    const host = args[0]!.trim();
+    if (host === "") throw new LegacyParamsError("the host (first argument) is empty");
+    return { Host: host, Port: legacyInteger(args[1]!, "port", "Port") };
+  },
+  legacyForm: "[hostIP, port] (MOSAIC's UDP_StreamlinedSender; later arguments are ignored)",
+  inputs: { min: 1, max: 1, labels: ["signal"] },
+  outputs: [],
+  views: ["label"],
+  panel: "Destination, datagrams sent and send errors.",
+  create(ctx, p) {
+    const input = signalInput(ctx, 0);
+    const size = input.size;
+    const pl = plan(p, size, sourceTypeOf(input.info));
+    const dest = endpointText(p.Host, p.Port);
+    const streamlined = p.Format === "streamlined";
+    const perValue = pl.serializer === "control";
+    const sEnc = streamlined ? new StreamlinedEncoder(perValue ? 1 : size, pl.type) : undefined;
+    const rEnc = streamlined ? undefined : new RawEncoder(size, p.Format as "f32" | "f64");
+    const subs = pl.subcategories;
+    const category = pl.category;
+    const scale = pl.scale;
+    const sendTime = p.Timestamp === "send";
+    const what = streamlined
+      ? `${pl.serializer} serializer, ${pl.type}, category ${category}`
+      : `raw ${p.Format}`;
+    const warns = new WarnLimiter(ctx);
+    const throttle = new TextThrottle();
+
+    let socket: UdpSocketHandle | undefined;
+    let sent = 0;
+    let failed = 0;
+    let notSent = 0;
+    let lastError = "";
+    let unavailable = false;
+    const describe = (): void => {
+      if (unavailable) {
+        ctx.setText(
+          `UDP is unavailable here (the browser build has no network sockets): ${plural(notSent, "event")} not sent`,
+        );
+        return;
+      }
+      const err = failed > 0 ? `, ${failed} failed (${lastError})` : "";
+      ctx.setText(`→ ${dest} (${what}): ${plural(sent, "datagram")} sent${err}`);
+    };
+    const bridge = udpBridge(ctx);
+    if (bridge) describe();
+    else unavailable = true;
+
+    const onError = (message: string): void => {
+      failed++;
+      lastError = message;
+      warns.warn(`UDP to ${dest}: ${message}`);
+      describe();
+    };
+
+    const close = (): void => {
+      const s = socket;
+      socket = undefined;
+      s?.close();
+    };
+
+    return {
+      start() {
+        if (!bridge) {
+          ctx.warn(
+            "UDP is unavailable here (the browser build has no network sockets): this block sends nothing",
+          );
+          return;
+        }
+        if (socket) return;
+        try {
+          socket = bridge.open({ remote: { host: p.Host, port: p.Port }, onError });
+        } catch (e) {
+          onError(e instanceof Error ? e.message : String(e));
+        }
+      },
+      process(f) {
+        const s = socket;
+        const n = f.n;
+        if (!s) {
+          notSent += n;
+          if (unavailable && n > 0 && throttle.due(f.t[n - 1]!)) describe();
+          return;
+        }
+        const v = f.v;
+        const stride = f.stride;
+        for (let e = 0; e < n; e++) {
+          const off = e * stride;
+          if (rEnc) {
+            s.send(rEnc.encode(v, off, scale));
+            sent++;
+          } else if (perValue) {
+            const t = sendTime ? ctx.now() : f.t[e]!;
+            for (let k = 0; k < size; k++) {
+              s.send(sEnc!.encode(t, category, subs[k]!, v, off + k, scale));
+              sent++;
+            }
+          } else {
+            const t = sendTime ? ctx.now() : f.t[e]!;
+            s.send(sEnc!.encode(t, category, subs[0]!, v, off, scale));
+            sent++;
+          }
+        }
+        if (n > 0 && throttle.due(f.t[n - 1]!)) describe();
+      },
+      stop() {
+        close();
+        describe();
+      },
+      reset() {
+        if (sEnc) sEnc.counter = 0;
+        sent = 0;
+        failed = 0;
+        notSent = 0;
+        lastError = "";
+        throttle.reset();
+        warns.reset();
+        describe();
+      },
+      dispose() {
+        close();
+      },
+    };
+  },
+});
