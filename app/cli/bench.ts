@@ -33,6 +33,7 @@ import {
   type ChildRun,
 } from "./bench-proc";
 import {
+  learnMarkdown,
   load,
   pipelineMarkdown,
   replayMarkdown,
@@ -40,11 +41,14 @@ import {
   targetsTable,
   type BlockRow,
   type CpuFigures,
+  type LearnResult,
   type PipelineResult,
   type ReplayResult,
   type TargetRow,
+  type UdpResult,
   type WorkloadResult,
 } from "./bench-report";
+import { udpLatencyLine } from "./bench-udp";
 
 const HELP = `mosaic bench — the standard performance suite (DESIGN.md §6, paper section V)
 
@@ -58,8 +62,9 @@ Markdown tables and writes DIR/latest.json and DIR/latest.md (default DIR: bench
   --duration S  steady-state seconds per pipeline after the warm-up (default 30; the timer
                 workloads use half, at least 2)
   --warmup S    seconds excluded at the start of each real-time run (default 5)
-  --only LIST   run only these workloads: ${"myo, delsys, hdemg, hdemg-features, timer, timer-precision, replay-32, replay-256"}
-                (a prefix before '-' selects a group: timer, replay)
+  --only LIST   run only these workloads: ${"myo, delsys, hdemg, hdemg-features, timer, timer-precision, replay-32, replay-256, learn, udp"}
+                (a prefix before '-' selects a group: timer, replay); learn is the
+                micro-benchmark of the learning kernels (ns per update and prediction)
   --out DIR     where to write latest.json and latest.md
   --quick       a smoke test: 1 s warm-up, 3 s steady state, short replays (about 40 s in all)
 
@@ -85,7 +90,20 @@ interface ReplayDef {
   rate: number;
   recordingSeconds: number;
 }
-type WorkloadDef = PipelineDef | ReplayDef;
+interface LearnDef {
+  kind: "learn";
+  id: string;
+  title: string;
+  dims: number[];
+  outputs: number;
+}
+interface UdpDef {
+  kind: "udp";
+  id: string;
+  title: string;
+  timerHz: number;
+}
+type WorkloadDef = PipelineDef | ReplayDef | LearnDef | UdpDef;
 
 const WORKLOADS: WorkloadDef[] = [
   {
@@ -144,6 +162,20 @@ const WORKLOADS: WorkloadDef[] = [
     channels: 256,
     rate: 2048,
     recordingSeconds: 4,
+  },
+  {
+    kind: "learn",
+    id: "learn",
+    title:
+      "Learning kernels (WASM micro-benchmarks): ridge and RFF, incremental update and prediction",
+    dims: [8, 64, 256],
+    outputs: 12,
+  },
+  {
+    kind: "udp",
+    id: "udp",
+    title: "UDP latency — datagram in → UdpReceiver → Function → UdpSender → datagram out",
+    timerHz: 200,
   },
 ];
 
@@ -472,6 +504,90 @@ async function runReplay(
   };
 }
 
+/**
+ * The learning micro-benchmark, in this process: ns per incremental update (with its prediction)
+ * and per prediction, through the WASM bindings the IncrementalPredictor uses.
+ */
+async function runLearn(def: LearnDef, o: { quick: boolean }): Promise<LearnResult> {
+  const before = la();
+  const secondsPerFigure = o.quick ? 0.1 : 0.5;
+  progress(`${def.id}: ridge and RFF at D = ${def.dims.join(", ")}, ${secondsPerFigure} s each`);
+  const base: LearnResult = {
+    kind: "learn",
+    id: def.id,
+    title: def.title,
+    ok: true,
+    secondsPerFigure,
+    figures: [],
+    loadAvgBefore: before,
+    loadAvgAfter: before,
+    killedAfterSummary: false,
+  };
+  try {
+    const { loadDspFromDisk } = await import("../host/validate");
+    const { benchLearning } = await import("../engine/dsp");
+    loadDspFromDisk();
+    base.figures = benchLearning(() => performance.now(), {
+      dims: def.dims,
+      outputs: def.outputs,
+      seconds: secondsPerFigure,
+    }).map((f) => ({ ...f, updateNs: round(f.updateNs, 1), predictNs: round(f.predictNs, 1) }));
+  } catch (e) {
+    base.ok = false;
+    base.error = (e as Error).message;
+  }
+  base.loadAvgAfter = la();
+  return base;
+}
+
+/** Loopback UDP latency through a small pipeline on one worker (app/cli/bench-udp.ts). */
+async function runUdp(def: UdpDef, o: { quick: boolean; root: string }): Promise<UdpResult> {
+  const before = la();
+  const samples = o.quick ? 500 : 5000;
+  progress(`${def.id}: ${samples} datagrams at 500 Hz, timer branch ${def.timerHz} Hz`);
+  const base = {
+    kind: "udp" as const,
+    id: def.id,
+    title: def.title,
+    loadAvgBefore: before,
+    killedAfterSummary: false as const,
+  };
+  try {
+    const { measureUdpLatency } = await import("./bench-udp");
+    // (the module is bundled into the CLI; the dynamic import keeps the call site obvious)
+    const r = await measureUdpLatency({
+      samples,
+      rate: 500,
+      timerHz: def.timerHz,
+      workerPath: join(o.root, "dist", "engine.worker.mjs"),
+      wasmPath: join(o.root, "core-wasm", "pkg", "mosaic_core_bg.wasm"),
+    });
+    return { ...base, ok: true, ...r, loadAvgAfter: la() };
+  } catch (e) {
+    return {
+      ...base,
+      ok: false,
+      error: (e as Error).message,
+      samples,
+      received: 0,
+      lost: 0,
+      rate: 500,
+      channels: 8,
+      timerHz: def.timerHz,
+      p50Ms: NaN,
+      p90Ms: NaN,
+      p99Ms: NaN,
+      maxMs: NaN,
+      meanMs: NaN,
+      inP50Ms: NaN,
+      inP99Ms: NaN,
+      outP50Ms: NaN,
+      outP99Ms: NaN,
+      loadAvgAfter: la(),
+    };
+  }
+}
+
 function writeAtomic(file: string, text: string): void {
   const tmp = `${file}.tmp`;
   writeFileSync(tmp, text);
@@ -596,6 +712,17 @@ export async function runBench(argv: string[]): Promise<number> {
         }
         results.push(r);
         for (const l of pipelineMarkdown(r, "##")) out(l);
+      } else if (def.kind === "learn") {
+        const r = await runLearn(def, { quick });
+        results.push(r);
+        for (const l of learnMarkdown(r, "##")) out(l);
+      } else if (def.kind === "udp") {
+        const r = await runUdp(def, { quick, root });
+        results.push(r);
+        out(`## ${r.title}`);
+        out();
+        out(r.ok ? udpLatencyLine(r) : `**Failed:** ${r.error ?? "unknown error"}`);
+        out();
       } else {
         tmp ??= mkdtempSync(join(tmpdir(), "mosaic-bench-"));
         const r = await runReplay(def, {
@@ -714,5 +841,10 @@ function markdown(
   for (const r of results) if (r.kind === "pipeline") lines.push(...pipelineMarkdown(r, "###"));
   const rs = results.filter((r): r is ReplayResult => r.kind === "replay");
   if (rs.length) lines.push(...replayMarkdown(rs, "##"));
+  for (const r of results) if (r.kind === "learn") lines.push(...learnMarkdown(r, "##"));
+  for (const r of results) {
+    if (r.kind !== "udp") continue;
+    lines.push(`## ${r.title}`, "", r.ok ? udpLatencyLine(r) : `**Failed:** ${r.error}`, "");
+  }
   return lines.join("\n") + "\n";
 }

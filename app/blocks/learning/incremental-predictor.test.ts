@@ -40,6 +40,32 @@ const linear = (x: readonly number[]) => [2 * x[0]! - x[1]! + 1, x[0]! + x[1]!];
 const point = (i: number) => [Math.sin(0.7 * i) * 3, Math.cos(0.3 * i) + i / 20];
 
 describe("IncrementalPredictor", () => {
+  test("a target stream changing every event rewrites the status at most every 0.25 s; start and stop at once", async () => {
+    const h = await predictor({}, 1, 1);
+    let writes = 0;
+    const ctx = h as unknown as { text: string };
+    let text = ctx.text;
+    Object.defineProperty(ctx, "text", {
+      get: () => text,
+      set: (v: string) => {
+        writes++;
+        text = v;
+      },
+    });
+    h.push(vectors([0], [[0.5]]), 1);
+    expect(h.text).toBe("learning [0.5]: untrained");
+    expect(writes).toBe(1);
+    // A ramp at 25 Hz for 1 s, each target followed by its feature event.
+    for (let i = 1; i <= 25; i++) {
+      h.push(vectors([i / 25], [[0.5 + i / 50]]), 1);
+      h.push(vectors([i / 25 + 0.001], [[i]]), 0);
+    }
+    expect(writes).toBeLessThanOrEqual(1 + 2 * 5);
+    expect(h.text).toMatch(/^learning \[0\.9\d*\]: trained on 2\d samples/);
+    h.push(vectors([1.1], [[NaN]]), 1);
+    expect(h.text).toMatch(/^trained on 25 samples/);
+  });
+
   test("trigger protocol: a target trains every later feature event until all-NaN; predictions always", async () => {
     const h = await predictor({ Lambda: 1e-6 }, 2, 2);
     expect(h.text).toBe("untrained (waiting for a target)");

@@ -212,9 +212,14 @@ export const IncrementalPredictor = defineBlock({
       return `saving the model (${plural(n, "sample")}) to ${file}`;
     };
 
-    /** Target events: a vector starts (or switches) training, all NaN stops it. */
+    /**
+     * Target events: a vector starts (or switches) training, all NaN stops it. The status text
+     * changes at once when training starts or stops; a target stream that changes every event
+     * (a Stimulus's ramps) updates it at most every 0.25 s, like the predictions.
+     */
     const onTarget = (f: Frame): void => {
       const v = f.v;
+      const was = hasTarget;
       for (let e = 0; e < f.n; e++) {
         let nan = 0;
         for (let k = 0; k < M; k++) if (Number.isNaN(v[e * M + k]!)) nan++;
@@ -231,7 +236,10 @@ export const IncrementalPredictor = defineBlock({
           hasTarget = true;
         }
       }
-      describe();
+      if (hasTarget !== was) {
+        throttle.reset();
+        describe();
+      } else if (throttle.due(f.t[f.n - 1]!)) describe();
     };
 
     const onFeatures = (f: Frame): void => {

@@ -1,7 +1,7 @@
 import { beforeAll, describe, expect, test } from "vitest";
 import { EMPTY_SHAPE, Frame, vectorShape } from "../../engine";
 import { BlockHarness, type Recorded } from "../../engine/testing";
-import { loadBlock, ticks } from "../../../tests/support/blocks";
+import { loadBlock, ticks, vectors } from "../../../tests/support/blocks";
 import { initDspForTests } from "../../../tests/support/wasm";
 import { DEFAULT_GESTURES, defaultGestures, EmgSimulator } from "./emg-simulator";
 
@@ -147,6 +147,147 @@ describe("EmgSimulator", () => {
     expect(rms(emg, 1, RATE / 2, RATE)).toBeGreaterThan(0.35);
     expect(rms(emg, 0, RATE / 2, RATE)).toBeLessThan(0.05);
     expect(h.output("gesture").v[0]).toEqual([0, 1, 0]);
+  });
+
+  describe("a simulated participant following cue inputs", () => {
+    /** A simulator with a timer and cue inputs of `width` values each. */
+    async function follower(params: object, width: number, cues = 1): Promise<BlockHarness> {
+      const inputs = [
+        timer,
+        ...Array.from({ length: cues }, () => ({ shape: vectorShape(width), rate: 25 })),
+      ];
+      const h = await BlockHarness.create(EmgSimulator, params, { inputs, now: 0 });
+      h.start();
+      return h;
+    }
+    const cue = (t: number, ...w: number[]): Frame => vectors([t], [w]);
+
+    test("one-hot cues: the gesture output follows them; the EMG takes the cued pattern", async () => {
+      const h = await follower({ Channels: 8, CueGestures: ["fist", "flexion"] }, 2);
+      expect(h.text).toBe("rest");
+      h.push(tickFrame(RATE / 2)); // 0.5 s of rest
+      h.push(cue(0.5, 0, 1), 1); // flexion from the first tick at or after 0.5 s
+      h.push(tickFrame(RATE, 0, RATE / 2));
+      h.push(cue(1.5, NaN, NaN), 1); // a stop: back to rest
+      h.push(tickFrame(RATE / 2, 0, RATE + RATE / 2));
+      const g = h.output("gesture").v;
+      const flexion = DEFAULT_GESTURES.indexOf("flexion");
+      expect(g[RATE / 2 - 1]![0]).toBe(1);
+      expect(g[RATE / 2]![flexion]).toBe(1);
+      expect(g[RATE / 2]!.reduce((a, b) => a + b, 0)).toBe(1);
+      expect(g[RATE + RATE / 2]![0]).toBe(1);
+      expect(h.text).toBe("rest (following cues)");
+      // Flexion is centred on channel 0, away from channel 4 (≈ 0.9 vs 0.05 activation).
+      const emg = h.output("emg");
+      expect(rms(emg, 0, RATE, RATE + RATE / 2)).toBeGreaterThan(0.3);
+      expect(rms(emg, 4, RATE, RATE + RATE / 2)).toBeLessThan(0.08);
+      expect(rms(emg, 0, 0, RATE / 2)).toBeLessThan(0.05);
+      // The same levels as holding flexion by the Gesture param (the same seed and generator).
+      const held = await sim({ Gesture: "flexion" });
+      held.push(tickFrame(RATE));
+      const ratio = rms(emg, 0, RATE, RATE + RATE / 2) / rms(held.output("emg"), 0, RATE / 2, RATE);
+      expect(ratio).toBeGreaterThan(0.85);
+      expect(ratio).toBeLessThan(1.15);
+    });
+
+    test("graded weights mix the patterns (rest + Σ w·(gesture − rest)), rest takes the remainder", async () => {
+      const gestures = { rest: [0.1, 0.1], a: [1, 0.1], b: [0.1, 0.6] };
+      const h = await follower({ Channels: 2, Gestures: gestures, CueGestures: ["a", "b"] }, 2);
+      h.push(cue(0, 0.5, 0.25), 1);
+      h.push(tickFrame(1));
+      expect(h.output("gesture").v[0]).toEqual([0.25, 0.5, 0.25]);
+      // Weights are clipped to 0..1 (the activations to 0..1); NaN and negatives count as 0.
+      h.push(cue(0.001, 3, -1), 1);
+      h.push(cue(0.0015, NaN, 0.5), 1);
+      h.push(tickFrame(2, 0, 2));
+      expect(h.output("gesture").v.slice(1)).toEqual([
+        [0, 1, 0],
+        [0.5, 0, 0.5],
+      ]);
+      expect(h.text).toBe("rest (following cues)");
+    });
+
+    test("ReactionMs delays the following; a cue input of all the gestures by default", async () => {
+      const h = await follower({ Channels: 4, ReactionMs: 250 }, DEFAULT_GESTURES.length);
+      const fist = DEFAULT_GESTURES.map((n) => (n === "fist" ? 1 : 0));
+      h.push(cue(0.1, ...fist), 1);
+      h.push(tickFrame(RATE));
+      const g = h.output("gesture").v.map((v) => v.indexOf(1));
+      expect(g.indexOf(1)).toBe(Math.round(0.35 * RATE));
+      expect(h.text).toBe("fist (following cues)");
+    });
+
+    test("the latest cue of any input wins, by time; batching does not matter", async () => {
+      const events: [number, number, number[]][] = [
+        [1, 0.1, [1, 0]],
+        [2, 0.2, [0, 1]],
+        [1, 0.3, [0.5, 0.5]],
+        [2, 0.31, [0, 0]],
+        [1, 0.6, [0, 1]],
+      ];
+      const params = { Channels: 3, CueGestures: ["fist", "open"] };
+      // All cues first, then one frame of ticks.
+      const whole = await follower(params, 2, 2);
+      for (const [port, t, w] of [...events].reverse()) whole.push(cue(t, ...w), port);
+      whole.push(tickFrame(RATE));
+      // Interleaved with frames of 7 ticks, each cue just before the ticks at its time.
+      const pieces = await follower(params, 2, 2);
+      let next = 0;
+      for (let k = 0; k < RATE; k += 7) {
+        while (next < events.length && events[next]![1] <= (k + 6) / RATE) {
+          const [port, t, w] = events[next++]!;
+          pieces.push(cue(t, ...w), port);
+        }
+        pieces.push(tickFrame(Math.min(7, RATE - k), 0, k));
+      }
+      expect(pieces.output("emg").v).toEqual(whole.output("emg").v);
+      expect(pieces.output("gesture").v).toEqual(whole.output("gesture").v);
+      const g = whole.output("gesture").v;
+      const at = (s: number) => g[Math.round(s * RATE)];
+      expect([at(0.05), at(0.15), at(0.25), at(0.305), at(0.5), at(0.7)]).toEqual([
+        [1, 0, 0, 0, 0, 0, 0, 0],
+        [0, 1, 0, 0, 0, 0, 0, 0],
+        [0, 0, 1, 0, 0, 0, 0, 0],
+        [0, 0.5, 0.5, 0, 0, 0, 0, 0],
+        [1, 0, 0, 0, 0, 0, 0, 0],
+        [0, 0, 1, 0, 0, 0, 0, 0],
+      ]);
+    });
+
+    test("setting a gesture by hand stops following until reset", async () => {
+      const h = await follower({ Channels: 2, CueGestures: ["fist"] }, 1);
+      h.push(cue(0, 1), 1);
+      h.push(tickFrame(2));
+      expect(h.output("gesture").v[1]![1]).toBe(1);
+      expect(h.instance.actions!.setGesture!.run("open")).toBe("gesture: open");
+      h.push(cue(0.01, 1), 1); // ignored
+      h.push(tickFrame(2, 0.02));
+      expect(h.output("gesture").v.at(-1)![2]).toBe(1);
+      h.instance.reset!();
+      h.clear();
+      h.push(cue(0, 1), 1);
+      h.push(tickFrame(2));
+      expect(h.output("gesture").v.at(-1)![1]).toBe(1);
+    });
+
+    test("errors: a Sequence with cue inputs, a cue input of the wrong width, unknown CueGestures", async () => {
+      await expect(
+        follower({ CueGestures: ["fist"], Sequence: [{ Gesture: "fist", Seconds: 1 }] }, 1),
+      ).rejects.toThrow("a Sequence and cue inputs both choose the gesture: give one or the other");
+      await expect(follower({}, 2)).rejects.toThrow(
+        "cue input 'in1' carries 2 values per event, but there are 8 cue gestures (every " +
+          "gesture: rest, fist, open, pinch, flexion, extension, pronation, supination); set " +
+          "CueGestures to the 2 gestures its values stand for",
+      );
+      const errors = loadBlock(
+        "T: { Type: ScheduledTimer, DesiredRate: 1000 }\n" +
+          "E: { Type: EmgSimulator, Inputs: [T], Params: { CueGestures: [fist, opn] } }\n",
+        "E",
+      ).errors;
+      expect(errors.map((e) => e.param)).toEqual(["CueGestures[1]"]);
+      expect(errors[0]!.message).toContain("unknown gesture 'opn'");
+      expect(errors[0]!.message).toContain("did you mean 'open'?");
+    });
   });
 
   test("errors: not a timer input, gesture vectors of the wrong length, unknown gesture names", async () => {

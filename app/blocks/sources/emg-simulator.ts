@@ -2,7 +2,7 @@ import { z } from "zod";
 import { BlockConfigError, closest, defineBlock, errorMessage, vectorShape } from "../../engine";
 import { EmgSynth } from "../../engine/dsp";
 import { requireDsp } from "../shared/dsp";
-import { inputName, timerInput } from "../shared/inputs";
+import { inputName, timerInput, vectorInput } from "../shared/inputs";
 
 /** Names of the default gesture set, in output (one-hot) order. */
 export const DEFAULT_GESTURES = [
@@ -102,6 +102,24 @@ const params = z
         "Gestures played one after the other from the pipeline start and cycled, e.g. " +
           "[{Gesture: rest, Seconds: 2}, {Gesture: fist, Seconds: 2}]",
       ),
+    CueGestures: z
+      .array(z.string().min(1))
+      .min(1)
+      .optional()
+      .describe(
+        "With cue inputs: the gesture that each value of a cue event stands for, e.g. [fist, " +
+          "open] for a Stimulus with targets [1, 0] and [0, 1] (default: every gesture, in the " +
+          "order of Gestures)",
+      ),
+    ReactionMs: z
+      .number()
+      .min(0)
+      .max(10_000)
+      .default(0)
+      .describe(
+        "With cue inputs: the simulated participant's reaction time, in ms (a cue is followed " +
+          "this long after its timestamp)",
+      ),
     AmplitudeMv: z
       .number()
       .min(0)
@@ -173,6 +191,15 @@ const params = z
         });
       }
     });
+    p.CueGestures?.forEach((g, i) => {
+      if (!names.includes(g)) {
+        ctx.addIssue({
+          code: "custom",
+          path: ["CueGestures", i],
+          message: unknownGesture(g, names),
+        });
+      }
+    });
     if (p.BandLowHz >= p.BandHighHz) {
       ctx.addIssue({
         code: "custom",
@@ -201,9 +228,18 @@ export const EmgSimulator = defineBlock({
     "`setGesture` and `next` actions (or changing Gesture while running) switch gestures by " +
     "hand, and setting a gesture stops the Sequence until `reset`. The `gesture` output is the " +
     "one-hot code of the current gesture (in the order of Gestures), for training targets. The " +
-    "same Seed gives the same signal, also under a Sequence.",
+    "same Seed gives the same signal, also under a Sequence. A simulated participant follows " +
+    "cues: every input after the timer is a cue input (e.g. a Stimulus's `target` output, a " +
+    "Trigger's `target`), whose events are vectors of weights w_k for the gestures `CueGestures` " +
+    "(default: all, in order). From the first tick at or after an event's time + ReactionMs, " +
+    "the activation of every channel is rest + Σ w_k·(gesture_k − rest), clipped to 0..1 (rest: " +
+    "the `rest` gesture's pattern, zeros without one; w_k clipped to 0..1, NaN counts as 0, so " +
+    "an all-NaN stop means rest), so a Stimulus's sin² ramps become graded contractions; the " +
+    "latest cue of any input wins, and `gesture` then carries the mixture (w_k at each cued " +
+    "gesture, 1 − Σ w at rest). Cue inputs and a Sequence exclude each other; setting a gesture " +
+    "by hand stops following cues until `reset`.",
   params,
-  inputs: { min: 1, max: 1, labels: ["timer"] },
+  inputs: { min: 1, max: Infinity, labels: ["timer", "cue"] },
   outputs: ["emg", "gesture"],
   live: ["Gesture"],
   views: ["scope", "spider", "heatmap", "label"],
@@ -248,6 +284,99 @@ export const EmgSimulator = defineBlock({
     const oneHot = ctx.output(vectorShape(names.length), "gesture");
 
     const seq = p.Sequence;
+    // Cue inputs: a simulated participant following cues (every input after the timer).
+    const cueMap = Int32Array.from(p.CueGestures ?? names, indexOf);
+    const K = cueMap.length;
+    const cueCount = ctx.inputs.length - 1;
+    for (let i = 1; i <= cueCount; i++) {
+      const c = vectorInput(ctx, i);
+      if (c.size !== K) {
+        throw new BlockConfigError(
+          `cue input ${inputName(c.info)} carries ${c.size} values per event, but there are ${K} ` +
+            `cue gestures (${names.length === K && p.CueGestures === undefined ? "every gesture" : "CueGestures"}: ` +
+            `${Array.from(cueMap, (g) => names[g]).join(", ")}); set CueGestures to the ${c.size} ` +
+            "gestures its values stand for",
+          "CueGestures",
+        );
+      }
+    }
+    const following = cueCount > 0;
+    if (following && seq !== undefined) {
+      throw new BlockConfigError(
+        "a Sequence and cue inputs both choose the gesture: give one or the other",
+        "Sequence",
+      );
+    }
+    const restIndex = names.indexOf("rest");
+    const restPattern = restIndex >= 0 ? patterns[restIndex]! : new Float64Array(channels);
+    const reaction = p.ReactionMs / 1000;
+    /** Pending cue events, sorted by time: rows [qHead, qEnd) of qT / qV. */
+    let qT = new Float64Array(following ? 16 : 0);
+    let qV = new Float64Array(following ? 16 * K : 0);
+    let qHead = 0;
+    let qEnd = 0;
+    const mix = new Float64Array(channels);
+    /** The `gesture` output while following cues: the weight of every gesture. */
+    const weights = new Float64Array(names.length);
+    let dominant = -1;
+
+    const enqueue = (t: number, v: Float64Array, off: number): void => {
+      if (qEnd === qT.length) {
+        if (qHead > 0) {
+          qT.copyWithin(0, qHead, qEnd);
+          qV.copyWithin(0, qHead * K, qEnd * K);
+          qEnd -= qHead;
+          qHead = 0;
+        } else {
+          const t2 = new Float64Array(qT.length * 2);
+          t2.set(qT);
+          const v2 = new Float64Array(qV.length * 2);
+          v2.set(qV);
+          qT = t2;
+          qV = v2;
+        }
+      }
+      // Keep the queue sorted by time (events of several inputs may interleave).
+      let i = qEnd++;
+      while (i > qHead && qT[i - 1]! > t) {
+        qT[i] = qT[i - 1]!;
+        qV.copyWithin(i * K, (i - 1) * K, i * K);
+        i--;
+      }
+      qT[i] = t;
+      for (let k = 0; k < K; k++) qV[i * K + k] = v[off + k]!;
+    };
+
+    /** Follows the cue in row `row` of the queue: new activation targets and gesture weights. */
+    const follow = (row: number): void => {
+      weights.fill(0);
+      mix.set(restPattern);
+      let sum = 0;
+      for (let k = 0; k < K; k++) {
+        let w = qV[row * K + k]!;
+        if (!(w > 0)) continue; // NaN and negative weights count as 0
+        if (w > 1) w = 1;
+        const g = cueMap[k]!;
+        weights[g] = weights[g]! + w;
+        sum += w;
+        const pat = patterns[g]!;
+        for (let c = 0; c < channels; c++) mix[c] = mix[c]! + w * (pat[c]! - restPattern[c]!);
+      }
+      for (let c = 0; c < channels; c++) {
+        const a = mix[c]!;
+        mix[c] = a < 0 ? 0 : a > 1 ? 1 : a;
+      }
+      if (restIndex >= 0 && sum < 1) weights[restIndex] = weights[restIndex]! + (1 - sum);
+      synth.setTargets(mix);
+      current = -1;
+      let best = 0;
+      for (let g = 1; g < weights.length; g++) if (weights[g]! > weights[best]!) best = g;
+      if (best !== dominant) {
+        dominant = best;
+        ctx.setText(`${names[best]} (following cues)`);
+      }
+    };
+
     const seqGesture = Int32Array.from(seq ?? [], (s) => indexOf(s.Gesture));
     const seqSeconds = Float64Array.from(seq ?? [], (s) => s.Seconds);
     const cycle = seqSeconds.reduce((a, b) => a + b, 0);
@@ -274,7 +403,13 @@ export const EmgSimulator = defineBlock({
       step = 0;
       stepEnd = NaN;
       current = -1;
-      select(seq !== undefined ? seqGesture[0]! : initialGesture);
+      qHead = 0;
+      qEnd = 0;
+      const g = seq !== undefined ? seqGesture[0]! : initialGesture;
+      weights.fill(0);
+      weights[g] = 1;
+      dominant = g;
+      select(g);
     };
     restart();
 
@@ -308,14 +443,22 @@ export const EmgSimulator = defineBlock({
     const setManual = (g: number): string => {
       manual = true;
       current = -1;
+      qHead = 0;
+      qEnd = 0;
       select(g);
       return `gesture: ${names[g]}`;
     };
 
     return {
-      process(f) {
+      process(f, port) {
         const n = f.n;
         if (n === 0) return;
+        if (port > 0) {
+          if (manual) return;
+          const stride = f.stride;
+          for (let e = 0; e < n; e++) enqueue(f.t[e]! + reaction, f.v, e * stride);
+          return;
+        }
         const o = emg.frame(n);
         const h = oneHot.frame(n);
         const ov = o.v;
@@ -327,13 +470,25 @@ export const EmgSimulator = defineBlock({
           const t = ft[e]!;
           o.t[e] = t;
           h.t[e] = t;
+          const off = e * g;
+          if (following && !manual) {
+            if (qEnd > qHead && qT[qHead]! <= t) {
+              let row = qHead;
+              while (qHead < qEnd && qT[qHead]! <= t) row = qHead++;
+              generate(ov, runStart, e);
+              runStart = e;
+              follow(row);
+              if (qHead === qEnd) qHead = qEnd = 0;
+            }
+            for (let k = 0; k < g; k++) hv[off + k] = weights[k]!;
+            continue;
+          }
           const want = gestureAt(t);
           if (want !== current) {
             generate(ov, runStart, e);
             runStart = e;
             select(want);
           }
-          const off = e * g;
           for (let k = 0; k < g; k++) hv[off + k] = 0;
           hv[off + current] = 1;
         }
@@ -377,7 +532,7 @@ export const EmgSimulator = defineBlock({
               select(seqGesture[step]!);
               return `gesture: ${names[current]}`;
             }
-            return setManual((current + 1) % names.length);
+            return setManual(((current >= 0 ? current : dominant) + 1) % names.length);
           },
         },
       },
