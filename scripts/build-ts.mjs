@@ -28,7 +28,11 @@ const common = {
 rmSync(join(root, "dist/chunks"), { recursive: true, force: true });
 await build({
   ...common,
-  entryPoints: present({ cli: "app/cli/main.ts", "engine.worker": "app/host/engine.worker.ts" }),
+  entryPoints: present({
+    cli: "app/cli/main.ts",
+    "engine.worker": "app/host/engine.worker.ts",
+    "session.worker": "app/host/session.worker.ts",
+  }),
   outdir: "dist",
   splitting: true,
   chunkNames: "chunks/[name]-[hash]",

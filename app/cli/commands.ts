@@ -5,7 +5,8 @@
  *   mosaic run FILE [options]          live per-block table (or --json lines); Ctrl-C stops cleanly
  *   mosaic bench [options]             the standard performance suite (see `mosaic bench --help`)
  */
-import { resolve } from "node:path";
+import { readFileSync } from "node:fs";
+import { dirname, join, resolve } from "node:path";
 import { parseArgs } from "node:util";
 import { formatDiagnostic } from "../engine/diagnostics";
 import type { Telemetry } from "../engine/runtime/runtime";
@@ -39,6 +40,11 @@ Usage:
       Serves the browser build (dist/web: the UI with the engine in the page's Web Worker, on
       simulated signals) and prints its URL; --pipeline preselects one of pipelines/ (default
       the demo). Ctrl-C stops it.
+  mosaic serve [FILE] [--port N] [--host ADDR] [--no-start]
+      Runs the engine here (with UDP, serial and the other device bridges) and serves the UI
+      for it: the same page as \`mosaic web\`, connected over a WebSocket that needs the token
+      in the printed URL. FILE is loaded and started (--no-start: only loaded); several tabs
+      may watch the same engine. Binds 127.0.0.1 unless --host says otherwise.
   mosaic bench [--duration S] [--warmup S] [--only NAME[,NAME]] [--out DIR] [--quick]
       Runs the standard benchmarks and writes bench/results/*.json and *.md.
   mosaic --help | --version
@@ -295,6 +301,73 @@ async function cmdWeb(args: string[]): Promise<number> {
   return 0;
 }
 
+async function cmdServe(args: string[]): Promise<number> {
+  const { values, positionals } = parseArgs({
+    args,
+    allowPositionals: true,
+    options: {
+      port: { type: "string", default: "8321" },
+      host: { type: "string", default: "127.0.0.1" },
+      "no-start": { type: "boolean", default: false },
+    },
+  });
+  const port = Number(values.port);
+  if (!Number.isInteger(port) || port < 0 || port > 65535) {
+    err(`mosaic serve: --port must be a port number, not '${values.port}'`);
+    return 2;
+  }
+  if (positionals.length > 1) {
+    err("mosaic serve: give at most one pipeline file");
+    return 2;
+  }
+  const root = webRoot();
+  if (!root) {
+    err("mosaic serve: the browser build is missing (dist/web): run `npm run build` first");
+    return 1;
+  }
+  const { serve } = await import("../host/serve");
+  const file = positionals[0] ? resolve(positionals[0]) : undefined;
+  let source: string | undefined;
+  if (file) {
+    try {
+      source = readFileSync(file, "utf8");
+    } catch (e) {
+      err(`mosaic serve: cannot read ${file}: ${(e as Error).message}`);
+      return 2;
+    }
+  }
+  let served;
+  try {
+    served = await serve({
+      webRoot: root,
+      port,
+      host: values.host,
+      pipelinesDir: join(dirname(root), "..", "pipelines"),
+      onProblem: (m) => err(`mosaic serve: ${m}`),
+    });
+  } catch (e) {
+    err(`mosaic serve: ${(e as Error).message}`);
+    return 1;
+  }
+  if (file && source !== undefined) {
+    const r = await served.hub.request({ type: "load", file, source });
+    for (const d of r.diagnostics ?? []) err(formatDiagnostic(d));
+    if (!r.ok) {
+      await served.close();
+      return 2;
+    }
+    if (!values["no-start"]) await served.hub.request({ type: "start" });
+  }
+  out(`MOSAIC is at ${served.url}`);
+  out("(the engine runs in this process; open the URL, token included; Ctrl-C stops it)");
+  await new Promise<void>((r) => {
+    process.once("SIGINT", r);
+    process.once("SIGTERM", r);
+  });
+  await served.close();
+  return 0;
+}
+
 export async function main(argv: string[]): Promise<number> {
   const [cmd, ...rest] = argv;
   switch (cmd) {
@@ -316,9 +389,11 @@ export async function main(argv: string[]): Promise<number> {
       return runBench(rest);
     case "web":
       return cmdWeb(rest);
+    case "serve":
+      return cmdServe(rest);
     default:
       err(
-        `mosaic: unknown command '${cmd}' (commands: validate, run, web, bench; see mosaic --help)`,
+        `mosaic: unknown command '${cmd}' (commands: validate, run, web, serve, bench; see mosaic --help)`,
       );
       return 2;
   }

@@ -144,6 +144,11 @@ export type EngineMessage =
       graph?: GraphInfo;
     }
   | { type: "state"; state: EngineState; file?: string }
+  /**
+   * The loaded pipeline's graph, sent to a client that did not load it: a second tab joining a
+   * shared engine (`mosaic serve`), or every other tab after one loads a file.
+   */
+  | { type: "graph"; graph: GraphInfo }
   | { type: "telemetry"; telemetry: Telemetry }
   | { type: "event"; event: RuntimeEvent }
   | DataMessage;

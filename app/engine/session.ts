@@ -21,6 +21,7 @@ import {
 import type { LogSink } from "./runtime/logsink";
 import { Runtime } from "./runtime/runtime";
 import type { Resources } from "./block";
+import type { IoBridges } from "./io";
 
 export interface LoopHandle {
   stop(): void;
@@ -42,6 +43,8 @@ export interface SessionPlatform {
   /** File access relative to the pipeline file's folder. */
   resources(file: string): Resources;
   logs?(file: string): LogSink | undefined;
+  /** Device and network bridges for blocks (the Node host's; none in the browser). */
+  io?: IoBridges;
   startLoop(rt: Runtime, hooks: LoopHooks): LoopHandle;
   post(msg: EngineMessage, transfer?: ArrayBuffer[]): void;
 }
@@ -277,6 +280,7 @@ export class EngineSession {
       virtual: false,
       resources: this.platform.resources(file),
       ...(logs ? { logs } : {}),
+      ...(this.platform.io ? { io: this.platform.io } : {}),
       ignorePlacement: true,
     });
     const diagnostics = [...loaded.diagnostics, ...created.diagnostics];

@@ -1,0 +1,329 @@
+/**
+ * The host's side of `mosaic serve` and the desktop app: one engine session in a worker thread
+ * (app/host/session.worker.ts), shared by any number of clients (browser tabs over WebSocket,
+ * the Electron window over IPC). The hub validates what clients send, gives each request a
+ * hub-wide id and routes the reply back to its client; telemetry, state and events go to every
+ * client; panel data goes to the clients watching that block (a block stays watched while any
+ * client watches it). A client that joins late gets the engine's hello, the loaded graph and the
+ * state at once; a client that goes away (a closed tab) only drops its watches: the pipeline runs
+ * on. `Path` logs are written here, and serial ports are opened here (see serial-proxy.ts).
+ */
+import { existsSync } from "node:fs";
+import { dirname, join } from "node:path";
+import { fileURLToPath } from "node:url";
+import { Worker } from "node:worker_threads";
+import { errorMessage } from "../engine/diagnostics";
+import {
+  parseUiMessage,
+  PROTOCOL_VERSION,
+  type EngineMessage,
+  type GraphInfo,
+  type UiMessage,
+} from "../engine/protocol";
+import { serialHub } from "../../native-bridges/serial-proxy";
+import { defaultWasmPath } from "./host";
+import { LogWriter } from "./log-writer";
+import type { HubToSession, SessionToHub } from "./session-protocol";
+import { takeTimeBase } from "./time-base";
+
+/** One client of the hub: where its engine messages go. */
+export interface HubClient {
+  send(msg: EngineMessage): void;
+}
+
+/** A connected client: what it sends goes to `receive`; `close` when it goes away. */
+export interface HubConnection {
+  receive(raw: unknown): void;
+  close(): void;
+}
+
+export interface SessionHubOptions {
+  /** Relative pipeline names from the UI's list resolve against this folder. */
+  pipelinesDir: string;
+  workerPath?: string;
+  wasmPath?: string;
+  /** The session worker died or a log could not be written. */
+  onProblem?(message: string): void;
+}
+
+type Reply = Extract<EngineMessage, { type: "reply" }>;
+/** A request without its id (the hub adds one); distributes over the union. */
+type Request<T = Extract<UiMessage, { id: number }>> = T extends unknown ? Omit<T, "id"> : never;
+
+interface Pending {
+  client?: Client;
+  clientId: number;
+  resolve?: (r: Reply) => void;
+}
+
+interface Client {
+  sink: HubClient;
+  /** Watch keys this client holds. */
+  watches: Set<string>;
+  open: boolean;
+  /** Said hello: gets broadcasts from then on (its first messages are hello, graph, state). */
+  greeted: boolean;
+}
+
+export function defaultSessionWorkerPath(): string {
+  const here = dirname(fileURLToPath(import.meta.url));
+  for (const p of [
+    join(here, "session.worker.mjs"),
+    join(here, "..", "..", "dist", "session.worker.mjs"),
+  ]) {
+    if (existsSync(p)) return p;
+  }
+  return join(here, "session.worker.mjs");
+}
+
+export class SessionHub {
+  private readonly worker: Worker;
+  private doorbell: Int32Array | undefined;
+  private readonly clients = new Set<Client>();
+  private readonly pending = new Map<number, Pending>();
+  private nextId = 1;
+  /** Watch key → clients holding it. */
+  private readonly watchers = new Map<string, Set<Client>>();
+  private hello: EngineMessage | undefined;
+  private graph: GraphInfo | undefined;
+  private lastState: EngineMessage | undefined;
+  private readonly logs = new Map<number, { writer: LogWriter; key: string }>();
+  private readonly writers = new Map<string, LogWriter>();
+  private readonly serial = serialHub((m) => this.toWorker(m));
+  private exited = false;
+  private readonly ready: Promise<void>;
+
+  private constructor(private readonly options: SessionHubOptions) {
+    this.worker = new Worker(options.workerPath ?? defaultSessionWorkerPath(), {
+      name: "mosaic-session",
+      resourceLimits: { maxYoungGenerationSizeMb: 8 },
+    });
+    this.ready = new Promise((resolve, reject) => {
+      const onMessage = (m: SessionToHub): void => {
+        if (m.type === "hello") {
+          this.hello = m;
+          resolve();
+        }
+      };
+      this.worker.on("message", onMessage);
+      this.worker.once("error", (e) => reject(e));
+    });
+    this.worker.on("message", (m: SessionToHub) => this.fromWorker(m));
+    this.worker.on("error", (e) => this.problem(`the engine crashed: ${errorMessage(e)}`));
+    this.worker.on("exit", (code) => {
+      this.exited = true;
+      this.serial.closeAll();
+      for (const w of this.writers.values()) w.closeAll();
+      if (code !== 0) this.problem(`the engine exited (code ${code})`);
+    });
+    this.toWorker({
+      type: "session-init",
+      wasmPath: options.wasmPath ?? defaultWasmPath(),
+      pipelinesDir: options.pipelinesDir,
+      timeBase: takeTimeBase(),
+    });
+    this.toWorker({ type: "hello", version: PROTOCOL_VERSION });
+  }
+
+  /** Starts the engine worker; resolves when it answered `hello`. */
+  static async start(options: SessionHubOptions): Promise<SessionHub> {
+    const hub = new SessionHub(options);
+    await hub.ready;
+    return hub;
+  }
+
+  get clientCount(): number {
+    return this.clients.size;
+  }
+
+  /** The graph of the loaded pipeline (undefined when none is loaded). */
+  get loaded(): GraphInfo | undefined {
+    return this.graph;
+  }
+
+  private problem(message: string): void {
+    this.options.onProblem?.(message);
+    this.broadcast({
+      type: "event",
+      event: { t: Date.now() / 1000, level: "error", block: "engine", message },
+    });
+  }
+
+  private toWorker(m: HubToSession): void {
+    if (this.exited) return;
+    this.worker.postMessage(m);
+    if (this.doorbell) {
+      Atomics.store(this.doorbell, 1, 1);
+      Atomics.add(this.doorbell, 0, 1);
+      Atomics.notify(this.doorbell, 0);
+    }
+  }
+
+  private broadcast(m: EngineMessage): void {
+    for (const c of this.clients) if (c.greeted) c.sink.send(m);
+  }
+
+  private fromWorker(m: SessionToHub): void {
+    switch (m.type) {
+      case "session-ready":
+        this.doorbell = new Int32Array(m.doorbell);
+        return;
+      case "hello":
+        this.hello = m;
+        return;
+      case "reply": {
+        const p = this.pending.get(m.id);
+        this.pending.delete(m.id);
+        if (!p) return;
+        if (m.graph !== undefined && m.ok) this.graph = m.graph;
+        else if (m.diagnostics !== undefined && !m.ok) this.graph = undefined;
+        const reply: Reply = { ...m, id: p.clientId };
+        p.resolve?.(reply);
+        if (p.client?.open) p.client.sink.send(reply);
+        // A pipeline loaded by one client is every client's: the others get the graph too.
+        if (m.graph !== undefined && m.ok) {
+          for (const c of this.clients)
+            if (c !== p.client) c.sink.send({ type: "graph", graph: m.graph });
+        }
+        return;
+      }
+      case "state":
+        this.lastState = m;
+        if (m.state === "empty") this.graph = undefined;
+        this.broadcast(m);
+        return;
+      case "telemetry":
+      case "event":
+        this.broadcast(m);
+        return;
+      case "graph":
+        this.graph = m.graph;
+        this.broadcast(m);
+        return;
+      case "data": {
+        const holders = this.watchers.get(m.block);
+        if (holders) for (const c of holders) if (c.open) c.sink.send(m);
+        return;
+      }
+      case "log-open": {
+        let writer = this.writers.get(m.baseDir);
+        if (!writer) {
+          writer = new LogWriter(m.baseDir, {
+            onError: (file, message) => this.problem(`log ${file}: ${message}`),
+          });
+          this.writers.set(m.baseDir, writer);
+        }
+        const key = `log:${m.id}`;
+        writer.open(key, m.block, m.port, m.isDefaultPort, m.path, m.shape, m.ring);
+        this.logs.set(m.id, { writer, key });
+        return;
+      }
+      case "log-close": {
+        const l = this.logs.get(m.id);
+        this.logs.delete(m.id);
+        l?.writer.close(l.key);
+        return;
+      }
+      case "serial":
+        this.serial.receive(m);
+        return;
+    }
+  }
+
+  /** Sends a request on behalf of the hub itself (not a client) and waits for the reply. */
+  request(msg: Request): Promise<Reply> {
+    return new Promise((resolve) => {
+      const id = this.nextId++;
+      this.pending.set(id, { clientId: id, resolve });
+      this.toWorker({ ...msg, id } as HubToSession);
+    });
+  }
+
+  connect(sink: HubClient): HubConnection {
+    const client: Client = { sink, watches: new Set(), open: true, greeted: false };
+    this.clients.add(client);
+    const replyTo = (id: number, ok: boolean, message?: string): void =>
+      sink.send({ type: "reply", id, ok, ...(message !== undefined ? { message } : {}) });
+    return {
+      receive: (raw) => {
+        if (!client.open) return;
+        const parsed = parseUiMessage(raw);
+        if (!parsed.ok) {
+          const id = (raw as { id?: unknown } | null)?.id;
+          replyTo(typeof id === "number" ? id : -1, false, parsed.error);
+          return;
+        }
+        const msg = parsed.msg;
+        if (msg.type === "hello") {
+          // The engine said hello once, at start; a client joining now gets it with the state.
+          if (this.hello) sink.send(this.hello);
+          if (this.graph) sink.send({ type: "graph", graph: this.graph });
+          if (this.lastState) sink.send(this.lastState);
+          client.greeted = true;
+          return;
+        }
+        if (msg.type === "watch" || msg.type === "unwatch") {
+          this.watch(client, msg);
+          return;
+        }
+        this.forward(client, msg);
+      },
+      close: () => {
+        if (!client.open) return;
+        client.open = false;
+        this.clients.delete(client);
+        for (const block of [...client.watches]) this.unwatchFor(client, block);
+        for (const p of this.pending.values()) if (p.client === client) p.client = undefined;
+      },
+    };
+  }
+
+  private forward(client: Client, msg: Extract<UiMessage, { id: number }>): void {
+    const id = this.nextId++;
+    this.pending.set(id, { client, clientId: msg.id });
+    this.toWorker({ ...msg, id });
+  }
+
+  private watch(client: Client, msg: Extract<UiMessage, { type: "watch" | "unwatch" }>): void {
+    const key = msg.block;
+    if (msg.type === "watch") {
+      const holders = this.watchers.get(key) ?? new Set<Client>();
+      const first = holders.size === 0;
+      holders.add(client);
+      client.watches.add(key);
+      this.watchers.set(key, holders);
+      if (first) this.forward(client, msg);
+      else client.sink.send({ type: "reply", id: msg.id, ok: true });
+      return;
+    }
+    const last = this.unwatchFor(client, key, msg.id);
+    if (!last) client.sink.send({ type: "reply", id: msg.id, ok: true });
+  }
+
+  /** Drops one client's watch; unwatches in the engine when it was the last. */
+  private unwatchFor(client: Client, key: string, replyId?: number): boolean {
+    const holders = this.watchers.get(key);
+    client.watches.delete(key);
+    if (!holders || !holders.delete(client)) return false;
+    if (holders.size > 0) return false;
+    this.watchers.delete(key);
+    if (replyId !== undefined && client.open) {
+      this.forward(client, { type: "unwatch", id: replyId, block: key });
+    } else {
+      const id = this.nextId++;
+      this.pending.set(id, { clientId: id });
+      this.toWorker({ type: "unwatch", id, block: key });
+    }
+    return true;
+  }
+
+  /** Stops the pipeline, closes the logs and ends the worker. */
+  async close(): Promise<void> {
+    if (this.exited) return;
+    await Promise.race([this.request({ type: "stop" }), new Promise((r) => setTimeout(r, 2000))]);
+    for (const w of this.writers.values()) w.closeAll();
+    this.serial.closeAll();
+    this.exited = true;
+    await this.worker.terminate();
+  }
+}

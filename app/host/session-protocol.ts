@@ -1,0 +1,34 @@
+/** Messages between the session hub (host main thread) and its session worker. */
+import type { Shape } from "../engine/frame";
+import type { EngineMessage, UiMessage } from "../engine/protocol";
+import type { SabRingInit } from "../engine/runtime/sab-ring";
+import type { SerialReply, SerialRequest } from "../../native-bridges/serial-proxy";
+import type { TimeBase } from "./time-base";
+
+export type HubToSession =
+  | {
+      type: "session-init";
+      wasmPath: string;
+      /** Relative pipeline file names (from the UI's list) are resolved against this folder. */
+      pipelinesDir: string;
+      timeBase: TimeBase;
+    }
+  | UiMessage
+  | SerialReply;
+
+export type SessionToHub =
+  | EngineMessage
+  | { type: "session-ready"; doorbell: SharedArrayBuffer }
+  | {
+      type: "log-open";
+      id: number;
+      baseDir: string;
+      block: string;
+      port: string;
+      isDefaultPort: boolean;
+      path: string;
+      shape: Shape;
+      ring: SabRingInit;
+    }
+  | { type: "log-close"; id: number }
+  | SerialRequest;
