@@ -22,7 +22,8 @@ fi
 # 2. npm packages (exact versions from package-lock.json).
 if [ ! -f node_modules/.package-lock.json ] || [ package-lock.json -nt node_modules/.package-lock.json ]; then
   say "installing npm packages"
-  npm ci --no-fund --no-audit
+  # The Electron binary cannot be downloaded on build machines; the desktop app is packaged elsewhere.
+  ELECTRON_SKIP_BINARY_DOWNLOAD=1 npm ci --no-fund --no-audit
 fi
 
 # 3. Rust: the wasm32 target and the pinned wasm-bindgen CLI (~4 minutes the first time).
