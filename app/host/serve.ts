@@ -10,7 +10,7 @@ import type { IncomingMessage } from "node:http";
 import type { Duplex } from "node:stream";
 import { WebSocketServer, type WebSocket } from "ws";
 import { errorMessage } from "../engine/diagnostics";
-import { decodeWire, encodeWire } from "../engine/wire";
+import { decodeWire, encodeWire } from "../engine/protocol-wire";
 import { SessionHub, type SessionHubOptions } from "./session-hub";
 import { serveStatic, type WebServer } from "./web-server";
 

@@ -7,7 +7,7 @@ import type { ChildProcess } from "node:child_process";
 import { afterAll, beforeAll, describe, expect, test } from "vitest";
 import WebSocket from "ws";
 import type { EngineMessage } from "../../app/engine/protocol";
-import { decodeWire, encodeWire } from "../../app/engine/wire";
+import { decodeWire, encodeWire } from "../../app/engine/protocol-wire";
 import { requireBuild, startCli } from "./helpers";
 
 let cli: ChildProcess;

@@ -1,6 +1,6 @@
 import fc from "fast-check";
 import { describe, expect, test } from "vitest";
-import { base64ToBytes, bytesToBase64, decodeWire, encodeWire } from "./wire";
+import { base64ToBytes, bytesToBase64, decodeWire, encodeWire } from "./protocol-wire";
 
 describe("wire codec (UI protocol over WebSocket)", () => {
   test("base64 matches Node's Buffer for every length", () => {
