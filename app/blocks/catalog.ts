@@ -24,6 +24,8 @@ import { SlidingWindow } from "./flow/sliding-window";
 import { Splitter } from "./flow/splitter";
 import { Switch } from "./flow/switch";
 import { VectorialFunction } from "./flow/vectorial-function";
+import { Ros } from "./io/ros";
+import { Myo } from "./io/myo";
 import { SerialPort } from "./io/serial-port";
 import { UdpReceiver } from "./io/udp-receiver";
 import { UdpSender } from "./io/udp-sender";
@@ -97,6 +99,8 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   UdpSender,
   UdpReceiver,
   SerialPort,
+  Myo,
+  Ros,
   // Recording
   Logger,
   // Testing

@@ -122,6 +122,85 @@ function loopbackSerial(): FakeIo {
   };
 }
 
+/**
+ * A rosbridge that connects at once and loops every published message back to the subscriptions
+ * of the same topic (as a ROS graph would); the messages are recorded as JSON.
+ */
+function loopbackRos(): FakeIo {
+  const sent: string[] = [];
+  const subs = new Map<string, ((msg: unknown) => void)[]>();
+  return {
+    io: {
+      ros: {
+        connect: (o) => {
+          o.onState("connecting");
+          o.onState("connected");
+          return {
+            advertise: ({ topic }) => ({
+              publish: (msg) => {
+                const text = JSON.stringify(msg);
+                sent.push(`${topic} ${text}`);
+                for (const f of subs.get(topic) ?? []) f(JSON.parse(text));
+                return true;
+              },
+              unadvertise: () => {},
+            }),
+            subscribe: ({ topic, onMessage }) => {
+              subs.set(topic, [...(subs.get(topic) ?? []), onMessage]);
+              return { unsubscribe: () => subs.delete(topic) };
+            },
+            close: () => {},
+          };
+        },
+      },
+    },
+    recorded: () => [...sent],
+    clear: () => (sent.length = 0),
+  };
+}
+
+/**
+ * A Bluetooth adapter with one Myo armband in range: it connects and accepts the Myo block's
+ * commands, but sends no notification (live data would not repeat after `reset`), so a paced Myo
+ * emits zeros until its first sample, as MOSAIC's did. Nothing is recorded for the same reason:
+ * the commands are written once, at start (myo.test.ts checks them).
+ */
+function quietMyo(): FakeIo {
+  const myo = (short: number): string =>
+    `d506${short.toString(16).padStart(4, "0")}a904deb947482c7f4a124842`;
+  const characteristics = [
+    [0x0001, 0x0401],
+    [0x0002, 0x0402],
+    [0x0005, 0x0105],
+    [0x0005, 0x0205],
+    [0x0005, 0x0305],
+    [0x0005, 0x0405],
+  ].map(([s, c]) => ({ service: myo(s!), uuid: myo(c!), properties: ["notify", "write"] }));
+  return {
+    io: {
+      ble: {
+        watchState: (onChange) => {
+          onChange("poweredOn");
+          return { close: () => {} };
+        },
+        scan: (o) => {
+          o.onFound({ address: "aa:bb:cc:dd:ee:01", name: "Myo", services: [myo(1)] });
+          return { stop: () => {} };
+        },
+        connect: async (address) => ({
+          address,
+          discover: async () => characteristics,
+          subscribe: async () => {},
+          write: async () => {},
+          disconnect: () => {},
+        }),
+      },
+    },
+    recorded: () => [],
+    clear: () => {},
+  };
+}
+
 const timer = (rate: number): InputSetup => ({ shape: EMPTY_SHAPE, rate, isTimer: true });
 const vec = (c: number, rate = 100): InputSetup => ({ shape: vectorShape(c), rate });
 const mat = (r: number, c: number, rate = 100): InputSetup => ({ shape: matrixShape(r, c), rate });
@@ -303,6 +382,11 @@ const SETUPS: Record<string, Setup | Setup[]> = {
     },
     { params: { Host: "::1", Port: 9, Format: "f32" }, inputs: [mat(2, 2)], io: recordingUdp },
   ],
+  // Paced by a timer (MOSAIC's form); fed by the armband's notifications alone in the second.
+  Myo: [
+    { params: {}, inputs: [timer(200)], io: quietMyo },
+    { params: { Address: "AA:BB:CC:DD:EE:01", EMG: "raw", IMU: false }, inputs: [], io: quietMyo },
+  ],
   // A source fed by its socket: nothing to feed here (tests/integration/udp.test.ts runs it).
   UdpReceiver: { params: { Port: 9, Channels: 3 }, inputs: [] },
   SerialPort: [
@@ -317,6 +401,26 @@ const SETUPS: Record<string, Setup | Setup[]> = {
       inputs: [vec(2)],
       io: loopbackSerial,
     },
+  ],
+  ROS: [
+    { params: { Topic: "/mosaic/out" }, inputs: [vec(3)], io: loopbackRos },
+    {
+      params: { Topic: "/m", MessageType: "std_msgs/Float32MultiArray" },
+      inputs: [mat(2, 2)],
+      io: loopbackRos,
+    },
+    {
+      params: { Topic: "cmd_vel", MessageType: "geometry_msgs/Twist" },
+      inputs: [vec(6)],
+      io: loopbackRos,
+    },
+    {
+      params: { Topic: "/j", MessageType: "sensor_msgs/JointState", JointNames: ["a", "b"] },
+      inputs: [vec(2)],
+      io: loopbackRos,
+    },
+    // A source fed by its connection: nothing to feed here (tests/integration/ros.test.ts runs it).
+    { params: { Topic: "/in", Direction: "subscribe", Channels: 2 }, inputs: [], io: loopbackRos },
   ],
   // Setups that end idle (no capture or trial in progress): `reset` would send the stop.
   Trigger: {

@@ -60,10 +60,138 @@ export interface SerialBridge {
   list(): Promise<{ path: string; manufacturer?: string }[]>;
 }
 
+/** One rosbridge connection's state, as `RosConnectOptions.onState` reports it. */
+export type RosConnectionState = "connecting" | "connected" | "disconnected";
+
+export interface RosConnectOptions {
+  /** The rosbridge server, `ws://host:port` or `wss://host:port`. */
+  url: string;
+  /**
+   * `connecting` first, `connected` once the WebSocket is open, then `disconnected` exactly once
+   * (with the reason: refused, closed by the server, a bad URL) — after a failed attempt as well
+   * as after a lost connection. A connection is never reopened: the caller connects again.
+   */
+  onState: (state: RosConnectionState, message?: string) => void;
+  /** Status and error messages the server sends (rosbridge `status` op), and protocol errors. */
+  onNotice?: (message: string) => void;
+}
+
+export interface RosPublisher {
+  /** Sends one message (rosbridge `publish`); false (and nothing sent) when not connected. */
+  publish(msg: object): boolean;
+  /** Stops publishing (rosbridge `unadvertise`). */
+  unadvertise(): void;
+}
+
+export interface RosSubscription {
+  /** Stops the callbacks (rosbridge `unsubscribe`). */
+  unsubscribe(): void;
+}
+
+export interface RosConnection {
+  /** Announces this client as a publisher of `topic` (rosbridge `advertise`). */
+  advertise(options: {
+    topic: string;
+    type: string;
+    latch?: boolean;
+    queueSize?: number;
+  }): RosPublisher;
+  /**
+   * Asks for the messages of `topic` (rosbridge `subscribe`); each arrives as the parsed `msg`
+   * object. `throttleMs` and `queueLength` are rosbridge's `throttle_rate` and `queue_length`.
+   */
+  subscribe(options: {
+    topic: string;
+    type: string;
+    throttleMs?: number;
+    queueLength?: number;
+    onMessage: (msg: unknown) => void;
+  }): RosSubscription;
+  /** Closes the WebSocket; no callbacks follow (not even `disconnected`). */
+  close(): void;
+}
+
+/** ROS through a rosbridge server (the rosbridge v2 JSON protocol over a WebSocket). */
+export interface RosBridge {
+  connect(options: RosConnectOptions): RosConnection;
+}
+
+/**
+ * Bluetooth LE (MOSAIC's BluetoothLEManager). UUIDs are written as noble writes them: 32
+ * lower-case hex digits without dashes for 128-bit UUIDs, 4 for 16-bit ones; bridges accept dashes
+ * and either case, and report them in that form. Addresses are "aa:bb:cc:dd:ee:ff" (lower case)
+ * where the OS reveals them, else the OS's id of the device (macOS).
+ */
+export type BleAdapterState =
+  | "unknown"
+  | "resetting"
+  | "unsupported"
+  | "unauthorized"
+  | "poweredOff"
+  | "poweredOn"
+  /** No adapter, or no BLE driver could be loaded: the message says why. */
+  | "unavailable";
+
+export interface BlePeripheral {
+  address: string;
+  name?: string;
+  rssi?: number;
+  /** Service UUIDs in its advertisement. */
+  services: string[];
+}
+
+export interface BleCharacteristic {
+  service: string;
+  uuid: string;
+  /** "read", "write", "writeWithoutResponse", "notify", "indicate", … */
+  properties: string[];
+}
+
+export interface BleConnection {
+  readonly address: string;
+  /** The characteristics of these services (all services when the list is empty). */
+  discover(services: readonly string[]): Promise<BleCharacteristic[]>;
+  /** Enables notifications (or indications); `onData` gets every value until disconnect. */
+  subscribe(
+    service: string,
+    characteristic: string,
+    onData: (data: Uint8Array) => void,
+  ): Promise<void>;
+  write(
+    service: string,
+    characteristic: string,
+    data: Uint8Array,
+    withoutResponse?: boolean,
+  ): Promise<void>;
+  /** Disconnects (idempotent); `onDisconnect` of `connect` is not called for this one. */
+  disconnect(): void;
+}
+
+export interface BleBridge {
+  /** Calls `onChange` with the adapter's state now and on every change, until `close`. */
+  watchState(onChange: (state: BleAdapterState, message?: string) => void): { close(): void };
+  /**
+   * Scans for peripherals advertising one of `services` (any when empty) until `stop`; each
+   * peripheral is reported once per scan. Several scans may run at once.
+   */
+  scan(options: {
+    services: readonly string[];
+    onFound: (peripheral: BlePeripheral) => void;
+    onError: (message: string) => void;
+  }): { stop(): void };
+  /**
+   * Connects to a peripheral found by a scan (by its address). `onDisconnect` reports a link
+   * lost later (out of range, switched off), never a `disconnect()` asked for.
+   */
+  connect(address: string, onDisconnect: (reason: string) => void): Promise<BleConnection>;
+}
+
 /** Every bridge the host could provide (all optional). Issue 6 fills these in. */
 export interface IoBridges {
   udp?: UdpBridge;
   serial?: SerialBridge;
+  ble?: BleBridge;
+  ros?: RosBridge;
   /** Bluetooth LE and ROS bridges are declared by their blocks' issue (6). */
   [name: string]: unknown;
 }

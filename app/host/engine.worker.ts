@@ -18,6 +18,8 @@ import { SabRing } from "../engine/runtime/sab-ring";
 import { runVirtual } from "../engine/runtime/virtual";
 import { RealtimeLoop } from "../engine/runtime/loop";
 import { serialProxy } from "../../native-bridges/serial-proxy";
+import { bleProxy } from "../../native-bridges/ble-proxy";
+import { nodeRosBridge } from "../../native-bridges/ros";
 import { nodeUdpBridge } from "../../native-bridges/udp";
 import { nodeResources } from "./resources";
 import { clockFromBase } from "./time-base";
@@ -100,7 +102,7 @@ async function create(msg: InitMessage): Promise<void> {
     clock,
     virtual,
     resources: nodeResources(dirname(msg.file)),
-    io: { udp: nodeUdpBridge(), serial: serial.bridge },
+    io: { udp: nodeUdpBridge(), ros: nodeRosBridge(), serial: serial.bridge, ble: ble.bridge },
     logs: sabLogSink(virtual),
     worker: msg.worker,
     ...(msg.plan ? { plan: msg.plan } : {}),
@@ -195,12 +197,17 @@ function stop(): void {
 
 /** Serial ports are opened by the host's main thread (see native-bridges/serial-proxy.ts). */
 const serial = serialProxy((m) => post(m));
+/** Bluetooth LE runs on the host's main thread too (see native-bridges/ble-proxy.ts). */
+const ble = bleProxy((m) => post(m));
 
 port.on("message", (msg: HostToWorker) => {
   try {
     switch (msg.type) {
       case "serial":
         serial.receive(msg);
+        break;
+      case "ble":
+        ble.receive(msg);
         break;
       case "init":
         void create(msg).catch((e: unknown) => post({ type: "fatal", message: errorMessage(e) }));

@@ -13,6 +13,7 @@ import { shapeSize } from "../engine/frame";
 import type { Plan, RuntimeEvent, Telemetry } from "../engine/runtime/runtime";
 import { SabRing } from "../engine/runtime/sab-ring";
 import { serialHub } from "../../native-bridges/serial-proxy";
+import { bleHub } from "../../native-bridges/ble-proxy";
 import { LogWriter } from "./log-writer";
 import { takeTimeBase } from "./time-base";
 import type { ClockMode, ControlOp, HostToWorker, WorkerToHost } from "./worker-protocol";
@@ -91,6 +92,8 @@ interface WorkerState {
   waiters: ((m: WorkerToHost) => boolean)[];
   /** The worker's serial ports, opened here (created on first use). */
   serial?: ReturnType<typeof serialHub>;
+  /** The worker's Bluetooth LE (noble runs here, not in workers: native-bridges/ble.ts). */
+  ble?: ReturnType<typeof bleHub>;
 }
 
 export interface LoadOutcome {
@@ -242,6 +245,7 @@ export class Host {
     worker.on("exit", (code) => {
       st.exited = true;
       st.serial?.closeAll();
+      st.ble?.closeAll();
       if (!st.stopped && code !== 0)
         this.events.fatal?.(`engine worker '${name}' exited with code ${code}`);
       for (const w of st.waiters.splice(0))
@@ -322,6 +326,12 @@ export class Host {
           if (!st.exited) this.post(st, r);
         });
         st.serial.receive(m);
+        break;
+      case "ble":
+        st.ble ??= bleHub((r) => {
+          if (!st.exited) this.post(st, r);
+        });
+        st.ble.receive(m);
         break;
       default:
         break;
@@ -434,6 +444,7 @@ export class Host {
       [...this.workers.values()].map(async (w) => {
         w.stopped = true;
         w.serial?.closeAll();
+        w.ble?.closeAll();
         if (!w.exited) await w.worker.terminate();
       }),
     );

@@ -20,6 +20,7 @@ import {
   type GraphInfo,
   type UiMessage,
 } from "../engine/protocol";
+import { bleHub } from "../../native-bridges/ble-proxy";
 import { serialHub } from "../../native-bridges/serial-proxy";
 import { defaultWasmPath } from "./host";
 import { LogWriter } from "./log-writer";
@@ -90,6 +91,7 @@ export class SessionHub {
   private readonly logs = new Map<number, { writer: LogWriter; key: string }>();
   private readonly writers = new Map<string, LogWriter>();
   private readonly serial = serialHub((m) => this.toWorker(m));
+  private readonly ble = bleHub((m) => this.toWorker(m));
   private exited = false;
   private readonly ready: Promise<void>;
 
@@ -113,6 +115,7 @@ export class SessionHub {
     this.worker.on("exit", (code) => {
       this.exited = true;
       this.serial.closeAll();
+      this.ble.closeAll();
       for (const w of this.writers.values()) w.closeAll();
       if (code !== 0) this.problem(`the engine exited (code ${code})`);
     });
@@ -227,6 +230,9 @@ export class SessionHub {
       case "serial":
         this.serial.receive(m);
         return;
+      case "ble":
+        this.ble.receive(m);
+        return;
     }
   }
 
@@ -323,6 +329,7 @@ export class SessionHub {
     await Promise.race([this.request({ type: "stop" }), new Promise((r) => setTimeout(r, 2000))]);
     for (const w of this.writers.values()) w.closeAll();
     this.serial.closeAll();
+    this.ble.closeAll();
     this.exited = true;
     await this.worker.terminate();
   }

@@ -2,6 +2,7 @@
 import type { Shape } from "../engine/frame";
 import type { EngineMessage, UiMessage } from "../engine/protocol";
 import type { SabRingInit } from "../engine/runtime/sab-ring";
+import type { BleReply, BleRequest } from "../../native-bridges/ble-proxy";
 import type { SerialReply, SerialRequest } from "../../native-bridges/serial-proxy";
 import type { TimeBase } from "./time-base";
 
@@ -14,7 +15,8 @@ export type HubToSession =
       timeBase: TimeBase;
     }
   | UiMessage
-  | SerialReply;
+  | SerialReply
+  | BleReply;
 
 export type SessionToHub =
   | EngineMessage
@@ -31,4 +33,5 @@ export type SessionToHub =
       ring: SabRingInit;
     }
   | { type: "log-close"; id: number }
-  | SerialRequest;
+  | SerialRequest
+  | BleRequest;

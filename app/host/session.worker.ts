@@ -17,6 +17,8 @@ import { RealtimeLoop } from "../engine/runtime/loop";
 import type { Runtime } from "../engine/runtime/runtime";
 import { SabRing } from "../engine/runtime/sab-ring";
 import { EngineSession, type LoopHooks } from "../engine/session";
+import { bleProxy } from "../../native-bridges/ble-proxy";
+import { nodeRosBridge } from "../../native-bridges/ros";
 import { serialProxy } from "../../native-bridges/serial-proxy";
 import { nodeUdpBridge } from "../../native-bridges/udp";
 import { nodeResources } from "./resources";
@@ -34,6 +36,7 @@ const pending: unknown[] = [];
 const doorbell = new Int32Array(new SharedArrayBuffer(8));
 let loop: RealtimeLoop | undefined;
 const serial = serialProxy((m) => post(m));
+const ble = bleProxy((m) => post(m));
 
 /** Where a pipeline's relative paths (data, logs) start: its folder. */
 function folderOf(file: string): string {
@@ -99,7 +102,7 @@ function boot(msg: Extract<HubToSession, { type: "session-init" }>): void {
     clock: () => clockFromBase(msg.timeBase) as MonotonicClock,
     resources: (file) => nodeResources(folderOf(file)),
     logs: (file) => logSink(file),
-    io: { udp: nodeUdpBridge(), serial: serial.bridge },
+    io: { udp: nodeUdpBridge(), ros: nodeRosBridge(), serial: serial.bridge, ble: ble.bridge },
     startLoop,
     post: (m, transfer) => post(m, transfer),
   });
@@ -111,6 +114,7 @@ port.on("message", (msg: HubToSession) => {
   try {
     if (msg.type === "session-init") boot(msg);
     else if (msg.type === "serial") serial.receive(msg);
+    else if (msg.type === "ble") ble.receive(msg);
     else if (session) void session.handle(msg);
     else pending.push(msg);
     // The loop turns the event loop only when rung or every 50 ms: answer at once.

@@ -4,6 +4,7 @@ import type { Shape } from "../engine/frame";
 import type { Plan, Telemetry } from "../engine/runtime/runtime";
 import type { SabRingInit } from "../engine/runtime/sab-ring";
 import type { SerialReply, SerialRequest } from "../../native-bridges/serial-proxy";
+import type { BleReply, BleRequest } from "../../native-bridges/ble-proxy";
 import type { TimeBase } from "./time-base";
 
 export type ClockMode = "realtime" | "virtual";
@@ -42,7 +43,8 @@ export type HostToWorker =
   | { type: "start" }
   | { type: "stop" }
   | ({ type: "control"; id: number } & ControlOp)
-  | SerialReply;
+  | SerialReply
+  | BleReply;
 
 export type WorkerToHost =
   | { type: "created"; plan: Plan; diagnostics: Diagnostic[]; doorbell: SharedArrayBuffer }
@@ -63,4 +65,5 @@ export type WorkerToHost =
   | { type: "finished"; telemetry: Telemetry }
   | { type: "stopped"; telemetry: Telemetry }
   | { type: "fatal"; message: string }
-  | SerialRequest;
+  | SerialRequest
+  | BleRequest;
