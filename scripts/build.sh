@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Builds the WASM DSP core (skipped when up to date) and the Node bundles in dist/.
+# Builds the WASM DSP core (skipped when up to date), the Node bundles, the browser build and
+# the desktop shell's bundles in dist/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build-wasm.sh
 node scripts/build-ts.mjs
 node scripts/build-web.mjs
+node scripts/build-electron.mjs

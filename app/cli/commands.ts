@@ -342,7 +342,8 @@ async function cmdServe(args: string[]): Promise<number> {
       webRoot: root,
       port,
       host: values.host,
-      pipelinesDir: join(dirname(root), "..", "pipelines"),
+      // The UI names its examples "pipelines/x.yaml", relative to the repository (= the web root).
+      pipelinesDir: join(dirname(root), ".."),
       onProblem: (m) => err(`mosaic serve: ${m}`),
     });
   } catch (e) {

