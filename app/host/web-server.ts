@@ -23,6 +23,14 @@ const TYPES: Record<string, string> = {
   ".png": "image/png",
 };
 
+export interface ServeOptions {
+  /**
+   * Send COOP/COEP (default true): the page is cross-origin isolated, so the engine worker gets
+   * SharedArrayBuffer. False serves the same files without them (tests of the fallback).
+   */
+  crossOriginIsolated?: boolean;
+}
+
 export interface WebServer {
   server: Server;
   url: string;
@@ -30,13 +38,24 @@ export interface WebServer {
 }
 
 /** Serves `root` on host:port (port 0 picks a free one). Rejects when the port is taken. */
-export function serveStatic(root: string, port: number, host = "127.0.0.1"): Promise<WebServer> {
+export function serveStatic(
+  root: string,
+  port: number,
+  host = "127.0.0.1",
+  options: ServeOptions = {},
+): Promise<WebServer> {
   const base = resolve(root);
+  const isolation: Record<string, string> =
+    options.crossOriginIsolated === false
+      ? {}
+      : {
+          "Cross-Origin-Opener-Policy": "same-origin",
+          "Cross-Origin-Embedder-Policy": "require-corp",
+          "Cross-Origin-Resource-Policy": "same-origin",
+        };
   const server = createServer((req, res) => {
     const headers = {
-      "Cross-Origin-Opener-Policy": "same-origin",
-      "Cross-Origin-Embedder-Policy": "require-corp",
-      "Cross-Origin-Resource-Policy": "same-origin",
+      ...isolation,
       "X-Content-Type-Options": "nosniff",
       "Cache-Control": "no-cache",
     };

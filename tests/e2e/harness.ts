@@ -61,14 +61,19 @@ export interface Served {
   close(): Promise<void>;
 }
 
-/** Serves dist/web plus the e2e fixtures under `e2e/`. */
-export async function serveApp(): Promise<Served> {
+/**
+ * Serves dist/web plus the e2e fixtures under `e2e/`; with `crossOriginIsolated: false`, without
+ * the COOP/COEP headers (no SharedArrayBuffer in the page: the engine's fallback).
+ */
+export async function serveApp(opts: { crossOriginIsolated?: boolean } = {}): Promise<Served> {
   ensureWebBuild();
   const root = mkdtempSync(join(tmpdir(), "mosaic-e2e-web-"));
   for (const e of readdirSync(WEB)) symlinkSync(join(WEB, e), join(root, e));
   mkdirSync(join(root, "e2e"));
   cpSync(join(ROOT, "tests/e2e/fixtures"), join(root, "e2e"), { recursive: true });
-  const server: WebServer = await serveStatic(root, 0);
+  const server: WebServer = await serveStatic(root, 0, "127.0.0.1", {
+    crossOriginIsolated: opts.crossOriginIsolated ?? true,
+  });
   return {
     url: server.url,
     root,

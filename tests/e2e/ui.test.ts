@@ -616,3 +616,140 @@ describe.skipIf(!haveChromium)("browser build, end to end (Chromium)", () => {
     await app.close();
   });
 });
+
+/** Distinct colours (quantised to 4 bits a channel) and the share of non-white pixels. */
+function canvasColours(page: Page, selector: string): Promise<{ colours: number; filled: number }> {
+  return page.$eval(selector, (c) => {
+    const canvas = c as {
+      width: number;
+      height: number;
+      getContext(k: "2d"): {
+        getImageData(x: number, y: number, w: number, h: number): { data: Uint8ClampedArray };
+      };
+    };
+    const { data } = canvas.getContext("2d").getImageData(0, 0, canvas.width, canvas.height);
+    const seen = new Set<number>();
+    let filled = 0;
+    for (let i = 0; i < data.length; i += 4) {
+      const r = data[i]!;
+      const g = data[i + 1]!;
+      const b = data[i + 2]!;
+      if (data[i + 3]! < 128 || (r > 240 && g > 240 && b > 240)) continue;
+      filled++;
+      seen.add(((r >> 4) << 8) | ((g >> 4) << 4) | (b >> 4));
+    }
+    return { colours: seen.size, filled: filled / (canvas.width * canvas.height) };
+  });
+}
+
+describe.skipIf(!haveChromium)("high-density EMG: the heatmap of a 256-channel grid", () => {
+  let served: Served;
+  let chromium: Chromium;
+
+  beforeAll(async () => {
+    served = await serveApp();
+    chromium = await launchChromium();
+  }, 120_000);
+
+  afterAll(async () => {
+    await chromium?.close();
+    await served?.close();
+  });
+
+  test("HDEMG's heatmap is a 16 × 16 grid of changing colours", async () => {
+    const app = await openApp(chromium, served.url, "pipelines/bench/hdemg.yaml");
+    const { page } = app;
+    await waitStatus(page, "HDEMG", "ontime", 10_000);
+    await page.click('.block-node[data-block="HDEMG"]');
+    const panel = '[data-panel="HDEMG"]';
+    await page.click(`${panel} [data-tab="heatmap"]`);
+    const canvas = `${panel} [data-view="heatmap"] canvas`;
+    await page.waitForSelector(canvas);
+    await page.waitForTimeout(1500);
+    const a = await canvasColours(page, canvas);
+    const shotA = await page.locator(canvas).first().screenshot();
+    await page.waitForTimeout(2500); // the gesture sequence moves on every 2 s
+    const shotB = await page.locator(canvas).first().screenshot();
+    await page.locator(panel).screenshot({ path: artifact("heatmap-hdemg.png") });
+    await page.screenshot({ path: artifact("heatmap-hdemg-page.png") });
+    console.log(
+      `heatmap: ${a.colours} colours, ${(a.filled * 100).toFixed(0)} % of the canvas coloured`,
+    );
+    // An activation map, not one flat colour: many cells of different values, most of the canvas.
+    expect(a.colours).toBeGreaterThan(30);
+    expect(a.filled).toBeGreaterThan(0.3);
+    expect(shotA.equals(shotB)).toBe(false);
+    // The inferred grid of 256 channels is 16 × 16.
+    expect(await page.getAttribute(canvas, "aria-label")).toContain("16 × 16");
+    expect(await page.textContent(`${panel} [data-view="heatmap"] .mp-foot`)).toContain(
+      "256 channels on a 16 × 16 grid",
+    );
+    expect(app.errors).toEqual([]);
+    await app.close();
+  });
+});
+
+describe.skipIf(!haveChromium)("without cross-origin isolation (no SharedArrayBuffer)", () => {
+  let served: Served;
+  let chromium: Chromium;
+
+  beforeAll(async () => {
+    served = await serveApp({ crossOriginIsolated: false });
+    chromium = await launchChromium();
+  }, 120_000);
+
+  afterAll(async () => {
+    await chromium?.close();
+    await served?.close();
+  });
+
+  test("the demo still runs on the coarse loop and the app says so", async () => {
+    // Every block that has been on time (green) at least once; on a busy machine the timer loop
+    // misses some ticks and a block may flip to lagging now and then, as it should.
+    const initScript = `
+      window.__green = new Set();
+      new MutationObserver(() => {
+        for (const e of document.querySelectorAll('.block-node[data-status="ontime"]'))
+          window.__green.add(e.dataset.block);
+      }).observe(document, { subtree: true, attributes: true, childList: true });`;
+    const app = await openApp(chromium, served.url, undefined, { initScript });
+    const { page } = app;
+    expect(await page.evaluate("self.crossOriginIsolated")).toBe(false);
+    await page.waitForSelector('.timing[data-shared-memory="false"]');
+    expect(await page.textContent(".timing")).toContain("coarse timing (no shared memory)");
+    await page.waitForFunction(
+      (n) => (globalThis as unknown as { __green: Set<string> }).__green.size === n,
+      DEMO_BLOCKS.length,
+      { timeout: 10_000, polling: 100 },
+    );
+    // Data moves: the timer keeps (nearly) its rate, the engine sends values, a scope redraws.
+    const timer = () =>
+      page.evaluate(() => {
+        const b = (globalThis as unknown as InPage).mosaic.client.telemetry?.blocks.find(
+          (x) => x.name === "Timer",
+        );
+        return { rate: b?.rate ?? 0, fired: b?.timer?.fired ?? 0, missed: b?.timer?.missed ?? 0 };
+      });
+    const t1 = await timer();
+    expect(await meanAbs(page, "LowPass", 600)).toBeGreaterThan(0);
+    await page.click('.block-node[data-block="Emg"]');
+    const plot = page.locator('[data-panel="Emg"] [data-view="scope"] .mp-plot');
+    await plot.locator("canvas").waitFor();
+    await page.waitForTimeout(800);
+    const a = await plot.screenshot();
+    await page.waitForTimeout(400);
+    const b = await plot.screenshot();
+    expect(a.equals(b)).toBe(false);
+    expect((await traceExtent(page, "Emg")).pixels).toBeGreaterThan(500);
+    const t2 = await timer();
+    console.log(
+      `no shared memory: Timer at ${t2.rate.toFixed(1)} Hz (200 wanted), ${t2.fired} ticks, ${t2.missed} missed`,
+    );
+    // (about 200 ticks a second; the timer loop misses a few on a loaded machine)
+    expect(t2.fired).toBeGreaterThan(t1.fired + 150);
+    expect(t2.rate).toBeGreaterThan(100);
+    await page.screenshot({ path: artifact("no-shared-memory.png") });
+    expect(app.errors).toEqual([]);
+    await app.close();
+  });
+});

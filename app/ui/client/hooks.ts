@@ -76,17 +76,35 @@ export function useGraph(): GraphInfo | undefined {
 }
 
 /**
+ * Holds back changes that need not show at once: while `ms` have not passed since the value
+ * last changed, a new value that `urgent` does not call urgent (e.g. a rate that moved by a few
+ * hertz) is not shown yet; the next telemetry after that shows it.
+ */
+export interface TelemetryHold<T> {
+  ms: number;
+  urgent(shown: T, next: T): boolean;
+}
+
+/**
  * A value derived from the latest telemetry: the component re-renders only when `select` gives a
  * result that `isEqual` says differs from the previous one (shallow equality by default), so a
- * node whose label did not change does not render at 20 Hz.
+ * node whose label did not change does not render at 20 Hz. With `hold`, numbers that change on
+ * every telemetry (rates, compute times) re-render at most every `hold.ms`: text changes cost a
+ * style and layout pass of the page each, and numbers changing 20 times a second cannot be read.
  */
 export function useTelemetrySelector<T>(
   select: (t: Telemetry | undefined) => T,
   isEqual: (a: T, b: T) => boolean = shallowEqual,
+  hold?: TelemetryHold<T>,
 ): T {
   const client = useEngine();
   const selectRef = useRef(select);
-  const cache = useRef<{ t: Telemetry | undefined; fresh: boolean; value: T } | null>(null);
+  const cache = useRef<{
+    t: Telemetry | undefined;
+    fresh: boolean;
+    value: T;
+    since: number;
+  } | null>(null);
   if (selectRef.current !== select) {
     // A new selector (its inputs changed): recompute, keeping the old value if equal.
     selectRef.current = select;
@@ -97,8 +115,17 @@ export function useTelemetrySelector<T>(
     const c = cache.current;
     if (c && c.fresh && c.t === t) return c.value;
     const next = selectRef.current(t);
-    const value = c && isEqual(c.value, next) ? c.value : next;
-    cache.current = { t, fresh: true, value };
+    const now = hold ? performance.now() : 0;
+    let value = next;
+    let since = now;
+    if (c && isEqual(c.value, next)) {
+      value = c.value;
+      since = c.since;
+    } else if (c && hold && now - c.since < hold.ms && !hold.urgent(c.value, next)) {
+      value = c.value;
+      since = c.since;
+    }
+    cache.current = { t, fresh: true, value, since };
     return value;
     // `isEqual` is read at call time: callers pass a module-level function.
   }, [client]);

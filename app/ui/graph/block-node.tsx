@@ -73,10 +73,23 @@ function blockView(t: Telemetry | undefined, name: string, running: boolean): Bl
   };
 }
 
+/** Rates and compute times show at most 4 times a second; everything else at once. */
+const HOLD = {
+  ms: 250,
+  urgent: (a: BlockView, b: BlockView): boolean =>
+    a.status !== b.status ||
+    a.stumbling !== b.stumbling ||
+    a.text !== b.text ||
+    a.errors !== b.errors ||
+    a.lastError !== b.lastError ||
+    a.dropsIn !== b.dropsIn ||
+    (a.rate === "–") !== (b.rate === "–"),
+};
+
 function BlockNodeComponent({ data }: NodeProps<BlockNodeType>) {
   const b = data.block;
   const g = useContext(GraphStateContext);
-  const v = useTelemetrySelector((t) => blockView(t, b.name, g.running));
+  const v = useTelemetrySelector((t) => blockView(t, b.name, g.running), undefined, HOLD);
   const both = v.status === "lagging" && v.stumbling;
   const label = statusText(v.status, v.stumbling);
   const desired =

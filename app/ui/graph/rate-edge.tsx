@@ -88,11 +88,21 @@ export function EdgeMarkerDefs() {
   );
 }
 
+/** The rate label changes at most 4 times a second; a new state or drop count at once. */
+const HOLD = {
+  ms: 250,
+  urgent: (a: EdgeView, b: EdgeView): boolean =>
+    a.state !== b.state ||
+    a.subscribed !== b.subscribed ||
+    a.dropped !== b.dropped ||
+    (a.rate === "–") !== (b.rate === "–"),
+};
+
 function RateEdgeComponent(props: EdgeProps<RateEdgeType>) {
   const { sourceX, sourceY, targetX, targetY, sourcePosition, targetPosition, data } = props;
   const g = useContext(GraphStateContext);
   const d = data!;
-  const v = useTelemetrySelector((t) => edgeView(t, d, g.running));
+  const v = useTelemetrySelector((t) => edgeView(t, d, g.running), undefined, HOLD);
   const [path, labelX, labelY] = getBezierPath({
     sourceX,
     sourceY,

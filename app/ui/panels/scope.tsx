@@ -1,8 +1,11 @@
 /**
- * Scope (paper III-C, Fig. 3): a time series of all or selected channels of a block output,
- * drawn with uPlot. Samples go into per-channel rings (ScopeBuffer) as data messages arrive
- * (20 per second); the plot is redrawn at most once per animation frame, with its right edge
- * following an estimate of the engine's clock so that it scrolls smoothly between messages.
+ * Scope (paper III-C, Fig. 3): a time series of all or selected channels of a block output.
+ * uPlot draws the axes and grid; the traces are rasterised into one image per frame
+ * (trace-raster.ts: a min-max run per pixel column, as an oscilloscope draws) and blitted over
+ * the plot area, which costs a fraction of stroking every segment. Samples go into per-channel
+ * rings (ScopeBuffer) as data messages arrive (20 per second); the plot is redrawn at most once
+ * per animation frame, with its right edge following an estimate of the engine's clock so that
+ * it scrolls smoothly between messages.
  * Autoscale (widens at once, narrows over ~2 s) or a fixed Y range; pause (stops watching and
  * freezes the picture); time window; channel selection (at most 16 plotted by default).
  */
@@ -23,6 +26,7 @@ import { ChannelPicker } from "./channel-picker";
 import { PlayPauseIcon, RangeInputs } from "./controls";
 import { countDraw, onFrame, viewStats } from "./frame";
 import { ScopeBuffer, type MatrixMode } from "./scope-buffer";
+import { rasterTraces, rgbaWord, traceScratch, type TraceScratch } from "./trace-raster";
 import type { ViewProps } from "./view-props";
 
 export interface ScopeSettings {
@@ -54,6 +58,50 @@ export const WINDOWS_S = [2, 5, 10, 30] as const;
  */
 export function scopeMaxRate(windowS: number): number {
   return Math.max(25, Math.min(1000, Math.round(1200 / windowS)));
+}
+
+const colourWords = new Map<string, number>();
+
+/** A CSS colour as an ImageData word (parsed once by a 1 × 1 canvas, then cached). */
+function colourWord(css: string): number {
+  let w = colourWords.get(css);
+  if (w === undefined) {
+    const ctx = document.createElement("canvas").getContext("2d", { willReadFrequently: true });
+    if (ctx) {
+      ctx.fillStyle = "#000";
+      ctx.fillStyle = css;
+      ctx.fillRect(0, 0, 1, 1);
+      const [r, g, b] = ctx.getImageData(0, 0, 1, 1).data;
+      w = rgbaWord(r!, g!, b!);
+    } else w = rgbaWord(0, 0, 0);
+    colourWords.set(css, w);
+  }
+  return w;
+}
+
+/** The offscreen image the traces are drawn into, sized to the plot area (device pixels). */
+interface TraceLayer {
+  canvas: HTMLCanvasElement;
+  ctx: CanvasRenderingContext2D;
+  image: ImageData;
+  words: Uint32Array;
+  scratch: TraceScratch;
+}
+
+function traceLayer(width: number, height: number): TraceLayer | null {
+  const canvas = document.createElement("canvas");
+  canvas.width = Math.max(1, width);
+  canvas.height = Math.max(1, height);
+  const ctx = canvas.getContext("2d");
+  if (!ctx) return null;
+  const image = ctx.createImageData(canvas.width, canvas.height);
+  return {
+    canvas,
+    ctx,
+    image,
+    words: new Uint32Array(image.data.buffer),
+    scratch: traceScratch(canvas.width),
+  };
 }
 
 /** How far behind the newest data the right edge runs: a little over one 20 Hz flush. */
@@ -94,6 +142,9 @@ export function Scope({
     received: 0,
     skipped: 0,
     lastInfo: 0,
+    /** The traces to blit (drawn in the frame loop, blitted by uPlot's draw hook). */
+    layer: null as TraceLayer | null,
+    colours: new Uint32Array(0),
   });
   live.current.settings = settings;
 
@@ -151,11 +202,22 @@ export function Scope({
       font: "11px system-ui, sans-serif",
       ...extra,
     });
+    l.colours = Uint32Array.from(channels, (c) => colourWord(channelColor(c)));
     const opts: uPlot.Options = {
       width: Math.max(100, el.clientWidth),
       height: PLOT_HEIGHT,
       legend: { show: false },
       cursor: { show: false },
+      hooks: {
+        // After the axes and grid: the traces, as one image over the plot area.
+        draw: [
+          (u) => {
+            const t = l.layer;
+            if (t && t.canvas.width === Math.round(u.bbox.width))
+              u.ctx.drawImage(t.canvas, Math.round(u.bbox.left), Math.round(u.bbox.top));
+          },
+        ],
+      },
       scales: {
         x: { time: false, range: () => [l.x[0], l.x[1]] },
         y: { range: () => [l.y[0], l.y[1]] },
@@ -177,17 +239,18 @@ export function Scope({
           },
         }),
       ],
-      series: [
-        {},
-        ...channels.map((c) => ({
-          label: channelLabel(output, c),
-          stroke: channelColor(c),
-          width: 1,
-          points: { show: false },
-        })),
-      ],
+      // One placeholder series on the y scale (so that uPlot ranges it and draws its axis);
+      // the channels are drawn by rasterTraces.
+      series: [{}, { label: "y", stroke: "transparent", points: { show: false } }],
     };
-    const plot = new uPlot(opts, buffer.view(-Infinity) as uPlot.AlignedData, el);
+    const plot = new uPlot(
+      opts,
+      [
+        [0, 1],
+        [null, null],
+      ],
+      el,
+    );
     l.plot = plot;
     l.dirty = true;
     const ro = new ResizeObserver(() => {
@@ -234,7 +297,28 @@ export function Scope({
         }
         l.y = l.sticky.update(lo, hi, l.lastDraw ? (now - l.lastDraw) / 1000 : 0);
       }
-      plot.batch(() => plot.setData(data as uPlot.AlignedData));
+      const bw = Math.round(plot.bbox.width);
+      const bh = Math.round(plot.bbox.height);
+      if (bw > 0 && bh > 0) {
+        if (!l.layer || l.layer.canvas.width !== bw || l.layer.canvas.height !== bh)
+          l.layer = traceLayer(bw, bh);
+        const t = l.layer;
+        if (t) {
+          rasterTraces(
+            { width: bw, height: bh, words: t.words },
+            t.scratch,
+            data[0]!,
+            data.slice(1),
+            l.colours,
+            l.x[0],
+            l.x[1],
+            l.y[0],
+            l.y[1],
+          );
+          t.ctx.putImageData(t.image, 0, 0);
+        }
+      }
+      plot.batch(() => plot.setData([l.x, [null, null]]));
       l.dirty = false;
       l.lastDraw = now;
       countDraw(stats, performance.now() - t0);

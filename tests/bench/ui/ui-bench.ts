@@ -2,23 +2,34 @@
  * UI benchmark (issue 5; a benchmark, not a test): the Delsys-like pipeline (32 ch @ 1926 Hz)
  * runs in the browser build with three scopes open; for 30 s it records the main thread's long
  * tasks (PerformanceObserver 'longtask': every task over 50 ms, count and longest) and each
- * scope's redraw rate (uPlot setData calls, counted by the panels in
- * `window.__mosaicPanelStats`), plus animation frames per second. Targets: no long task over
- * 50 ms in 30 s; every scope ≥ 30 redraws per second. Prints the figures and writes
- * bench/results/ui.json and ui.md.
+ * scope's redraw rate (draws counted by the panels in `window.__mosaicPanelStats`), the page's
+ * frame rate (requestAnimationFrame), how busy the main thread is (Chrome's TaskDuration over wall
+ * time, CDP Performance.getMetrics) and the CPU time of Chromium's threads (Linux /proc: unlike
+ * wall-clock figures, not inflated when other programs compete for the cores). Targets: no long
+ * task over 50 ms in 30 s; every scope ≥ 30 redraws per second. Prints the figures and writes
+ * bench/results/ui-latest.json and ui-latest.md.
  *
  * Run: `npm run bench:ui` (= node scripts/build-ts.mjs && node scripts/build-web.mjs &&
- * node tests/bench/ui/run.mjs [options]). Options: --mode app|harness (app: the real shell,
- * panels opened by clicking the graph's nodes [data-block]; harness: the panels alone, see
- * harness.tsx), --seconds 30, --warmup 5, --pipeline pipelines/bench/delsys.yaml,
- * --blocks Delsys,LowPass,Resampler, --shots DIR (screenshots of every tab of every panel),
- * --no-write (print only).
+ * node tests/bench/ui/run.mjs [options]; `npm run bench:ui -- --seconds 10` etc.). Options:
+ * --mode app|harness (app: the real shell, panels opened by clicking the graph's nodes
+ * [data-block]; harness: the panels alone, see harness.tsx), --seconds 30, --warmup 5,
+ * --pipeline pipelines/bench/delsys.yaml, --blocks Delsys,LowPass,Resampler (--blocks "" opens
+ * none: the cost of the graph alone), --shots DIR (screenshots of every tab of every panel),
+ * --trace FILE (a 5 s Chrome trace and a summary of the main thread's work), --no-write.
  */
-import { createReadStream, existsSync, mkdirSync, statSync, writeFileSync } from "node:fs";
+import {
+  createReadStream,
+  existsSync,
+  mkdirSync,
+  readdirSync,
+  readFileSync,
+  statSync,
+  writeFileSync,
+} from "node:fs";
 import { createServer, type Server } from "node:http";
 import { cpus, loadavg } from "node:os";
 import { extname, join, normalize, resolve, sep } from "node:path";
-import { chromium, type Browser, type Page } from "playwright-core";
+import { chromium, type Browser, type CDPSession, type Page } from "playwright-core";
 
 const ROOT = resolve(process.env.MOSAIC_ROOT ?? process.cwd());
 const WEB = join(ROOT, "dist/web");
@@ -31,6 +42,8 @@ interface Options {
   pipeline: string;
   blocks: string[];
   shots: string | undefined;
+  /** A Chrome trace of 5 s after the measurement, with a summary of the main thread's work. */
+  trace: string | undefined;
   write: boolean;
   chromium: string;
 }
@@ -43,6 +56,7 @@ function parseArgs(argv: string[]): Options {
     pipeline: "pipelines/bench/delsys.yaml",
     blocks: ["Delsys", "LowPass", "Resampler"],
     shots: undefined,
+    trace: undefined,
     write: true,
     chromium: process.env.CHROMIUM ?? "/usr/bin/chromium",
   };
@@ -62,6 +76,7 @@ function parseArgs(argv: string[]): Options {
     else if (a === "--pipeline") o.pipeline = next();
     else if (a === "--blocks") o.blocks = next().split(",").filter(Boolean);
     else if (a === "--shots") o.shots = resolve(next());
+    else if (a === "--trace") o.trace = resolve(next());
     else if (a === "--no-write") o.write = false;
     else if (a === "--chromium") o.chromium = next();
     else throw new Error(`unknown option ${a}`);
@@ -114,8 +129,11 @@ function serve(): Promise<{ server: Server; url: string }> {
   );
 }
 
-/** Installed before any page script: every long task the main thread runs. */
+/** Installed before any page script: every long task the main thread runs, and every frame. */
 const LONGTASK_OBSERVER = `
+  window.__benchRaf = 0;
+  const countFrame = () => { window.__benchRaf++; requestAnimationFrame(countFrame); };
+  requestAnimationFrame(countFrame);
   window.__benchLongTasks = [];
   try {
     new PerformanceObserver((list) => {
@@ -156,6 +174,8 @@ interface ViewStats {
 }
 interface Snapshot {
   now: number;
+  /** requestAnimationFrame callbacks of the page (its frame rate). */
+  raf: number;
   frames: number;
   tasks: number;
   views: Record<string, ViewStats>;
@@ -174,7 +194,7 @@ interface LongFrame {
 
 const SNAPSHOT = `(() => {
   const s = window.__mosaicPanelStats ?? { frames: 0, tasks: 0, views: {} };
-  return { now: performance.now(), frames: s.frames, tasks: s.tasks, views: JSON.parse(JSON.stringify(s.views)), longTasks: window.__benchLongTasks ?? [], loaf: window.__benchLoaf ?? [] };
+  return { now: performance.now(), raf: window.__benchRaf ?? 0, frames: s.frames, tasks: s.tasks, views: JSON.parse(JSON.stringify(s.views)), longTasks: window.__benchLongTasks ?? [], loaf: window.__benchLoaf ?? [] };
 })()`;
 
 async function snapshot(page: Page): Promise<Snapshot> {
@@ -183,7 +203,7 @@ async function snapshot(page: Page): Promise<Snapshot> {
 
 const TELEMETRY = `(() => {
   const t = window.mosaic?.client?.telemetry;
-  return t ? t.blocks.map((b) => ({ name: b.name, status: b.status, rate: b.rate, desiredRate: b.desiredRate, dropsIn: b.dropsIn, computeMaxMs: b.computeMaxMs })) : [];
+  return t ? t.blocks.map((b) => ({ name: b.name, status: b.status, rate: b.rate, desiredRate: b.desiredRate, dropsIn: b.dropsIn, computeMaxMs: b.computeMaxMs, fired: b.timer?.fired, missed: b.timer?.missed })) : [];
 })()`;
 
 async function openPanels(page: Page, o: Options, base: string): Promise<void> {
@@ -231,7 +251,26 @@ interface Figures {
   longTasks: { count: number; maxMs: number; totalMs: number; durationsMs: number[] };
   /** Long animation frames over 50 ms in the window, with the scripts they ran (diagnosis). */
   longFrames: LongFrame[];
-  frames: { perSecond: number };
+  /** Page frames (requestAnimationFrame) and frames of the panels' shared draw loop, per second. */
+  frames: { perSecond: number; panelLoopPerSecond: number };
+  /**
+   * The renderer's main thread, from Chrome's own counters (CDP Performance.getMetrics):
+   * share of the wall time spent in tasks, and of it in script, style and layout (the rest is
+   * mostly paint and compositing work on the main thread).
+   */
+  /**
+   * CPU use of Chromium's threads over the window (% of one core, from /proc), keyed
+   * "process type/thread": renderer/main is the page's main thread, renderer/DedicatedWorker the
+   * engine, gpu-process/VizCompositor the software compositor.
+   */
+  cpuPercent: Record<string, number>;
+  mainThread: {
+    busyPercent: number;
+    scriptPercent: number;
+    stylePercent: number;
+    layoutPercent: number;
+    otherPercent: number;
+  };
   scopes: {
     view: string;
     redrawsPerSecond: number;
@@ -242,12 +281,94 @@ interface Figures {
     skippedPerSecond: number;
   }[];
   afterClose: { tasks: number; messagesInOneSecond: number } | undefined;
-  engine: { name: string; status: string; rate: number; desiredRate: number; dropsIn: number }[];
+  engine: {
+    name: string;
+    status: string;
+    rate: number;
+    desiredRate: number;
+    dropsIn: number;
+    /** Timers: ticks fired and missed (late ticks skipped) since the start. */
+    fired?: number;
+    missed?: number;
+  }[];
   targets: { noLongTask: boolean; scopesAt30fps: boolean };
 }
 
+/**
+ * CPU time (seconds) of every thread of the Chromium processes this benchmark started (Linux
+ * /proc; empty elsewhere), by "process type/thread name". Unlike wall-clock task durations, CPU
+ * time does not grow when other programs compete for the cores.
+ */
+function cpuTimes(): Map<string, number> {
+  const out = new Map<string, number>();
+  let pids: string[];
+  try {
+    pids = readdirSync("/proc").filter((d) => /^\d+$/.test(d));
+  } catch {
+    return out;
+  }
+  const parent = new Map<string, string>();
+  for (const p of pids) {
+    try {
+      const stat = readFileSync(`/proc/${p}/stat`, "utf8");
+      parent.set(p, stat.slice(stat.lastIndexOf(")") + 2).split(" ")[1]!);
+    } catch {
+      // gone
+    }
+  }
+  const mine = (p: string): boolean => {
+    for (let q: string | undefined = p, i = 0; q && q !== "0" && i < 20; q = parent.get(q), i++)
+      if (q === String(process.pid)) return p !== String(process.pid);
+    return false;
+  };
+  const tick = 100; // USER_HZ on Linux
+  for (const p of parent.keys()) {
+    if (!mine(p)) continue;
+    let type = "browser";
+    try {
+      const cmd = readFileSync(`/proc/${p}/cmdline`, "utf8");
+      type = /--type=([a-z-]+)/.exec(cmd)?.[1] ?? "browser";
+      if (/--extension-process|--utility-sub-type=[^\0]*network/.test(cmd)) type += "*";
+    } catch {
+      continue;
+    }
+    let tids: string[] = [];
+    try {
+      tids = readdirSync(`/proc/${p}/task`);
+    } catch {
+      continue;
+    }
+    for (const t of tids) {
+      try {
+        const comm = readFileSync(`/proc/${p}/task/${t}/comm`, "utf8").trim();
+        const stat = readFileSync(`/proc/${p}/task/${t}/stat`, "utf8");
+        const f = stat.slice(stat.lastIndexOf(")") + 2).split(" ");
+        const sec = (Number(f[11]) + Number(f[12])) / tick;
+        const name = t === p ? "main" : comm.replace(/\d+$/, "");
+        const k = `${type}/${name}`;
+        out.set(k, (out.get(k) ?? 0) + sec);
+      } catch {
+        // thread gone
+      }
+    }
+  }
+  return out;
+}
+
+/** Chrome's main-thread counters (seconds), through the DevTools protocol. */
+async function metrics(cdp: CDPSession): Promise<Record<string, number>> {
+  const r = (await cdp.send("Performance.getMetrics")) as {
+    metrics: { name: string; value: number }[];
+  };
+  return Object.fromEntries(r.metrics.map((m) => [m.name, m.value]));
+}
+
 async function measure(page: Page, o: Options): Promise<Figures> {
+  const cdp = await page.context().newCDPSession(page);
+  await cdp.send("Performance.enable", { timeDomain: "timeTicks" });
   await page.waitForTimeout(o.warmup * 1000);
+  const m0 = await metrics(cdp);
+  const c0 = cpuTimes();
   const start = await snapshot(page);
   const perSecond: Record<string, number[]> = {};
   let prev = start;
@@ -262,7 +383,20 @@ async function measure(page: Page, o: Options): Promise<Figures> {
     prev = cur;
   }
   const end = prev;
+  const m1 = await metrics(cdp);
+  const c1 = cpuTimes();
   const elapsed = (end.now - start.now) / 1000;
+  const wall = (m1.Timestamp ?? 0) - (m0.Timestamp ?? 0) || elapsed;
+  const share = (k: string): number => round((100 * ((m1[k] ?? 0) - (m0[k] ?? 0))) / wall, 1);
+  const busy = share("TaskDuration");
+  const cpu: Record<string, number> = {};
+  for (const [k, v] of c1) {
+    const used = round((100 * (v - (c0.get(k) ?? 0))) / wall, 1);
+    if (used >= 0.5) cpu[k] = used;
+  }
+  const script = share("ScriptDuration");
+  const style = share("RecalcStyleDuration");
+  const layout = share("LayoutDuration");
   const tasks = end.longTasks.filter((t) => t.start >= start.now && t.start <= end.now);
   const scopes = Object.entries(end.views)
     .filter(([k]) => k.startsWith("scope:"))
@@ -317,7 +451,18 @@ async function measure(page: Page, o: Options): Promise<Figures> {
         render: round(f.render, 0),
         layout: round(f.layout, 0),
       })),
-    frames: { perSecond: round((end.frames - start.frames) / elapsed, 1) },
+    frames: {
+      perSecond: round((end.raf - start.raf) / elapsed, 1),
+      panelLoopPerSecond: round((end.frames - start.frames) / elapsed, 1),
+    },
+    cpuPercent: Object.fromEntries(Object.entries(cpu).sort((a, b) => b[1] - a[1])),
+    mainThread: {
+      busyPercent: busy,
+      scriptPercent: script,
+      stylePercent: style,
+      layoutPercent: layout,
+      otherPercent: round(Math.max(0, busy - script - style - layout), 1),
+    },
     scopes,
     afterClose: undefined,
     engine,
@@ -375,6 +520,56 @@ async function screenshots(page: Page, o: Options, dir: string): Promise<string[
   return files;
 }
 
+interface TraceEvent {
+  name: string;
+  ph: string;
+  ts: number;
+  dur?: number;
+  pid: number;
+  tid: number;
+  args?: { name?: string };
+}
+
+/**
+ * Records a Chrome trace for 5 s and prints where the renderer's main thread spent its time:
+ * the events with the most total duration (an event's time includes the events nested in it).
+ */
+async function trace(browser: Browser, page: Page, file: string): Promise<void> {
+  await browser.startTracing(page, {
+    path: file,
+    categories: [
+      "devtools.timeline",
+      "disabled-by-default-devtools.timeline",
+      "blink",
+      "cc",
+      "gpu",
+    ],
+  });
+  await page.waitForTimeout(5000);
+  const buf = await browser.stopTracing();
+  const parsed = JSON.parse(buf.toString()) as { traceEvents: TraceEvent[] } | TraceEvent[];
+  const events = Array.isArray(parsed) ? parsed : parsed.traceEvents;
+  const threads = new Map<string, string>();
+  for (const e of events)
+    if (e.ph === "M" && e.name === "thread_name")
+      threads.set(`${e.pid}:${e.tid}`, e.args?.name ?? "");
+  const totals = new Map<string, { ms: number; n: number }>();
+  for (const e of events) {
+    if (e.ph !== "X" || e.dur === undefined) continue;
+    const thread = threads.get(`${e.pid}:${e.tid}`) ?? "?";
+    if (!/CrRendererMain|Compositor|Raster|VizCompositor|CrGpuMain/.test(thread)) continue;
+    const k = `${thread.replace(/Thread.*/, "")} ${e.name}`;
+    const t = totals.get(k) ?? { ms: 0, n: 0 };
+    t.ms += e.dur / 1000;
+    t.n++;
+    totals.set(k, t);
+  }
+  const top = [...totals.entries()].sort((a, b) => b[1].ms - a[1].ms).slice(0, 40);
+  console.log(`ui-bench: trace in ${file}; over 5 s, the longest (nested times included):`);
+  for (const [k, t] of top)
+    console.log(`  ${k.padEnd(60)} ${t.ms.toFixed(0).padStart(6)} ms  ×${t.n}`);
+}
+
 const round = (x: number, d: number): number => Math.round(x * 10 ** d) / 10 ** d;
 
 function markdown(f: Figures): string {
@@ -391,7 +586,9 @@ function markdown(f: Figures): string {
       (s) =>
         `| ${s.view} redraws/s (slowest second) | ≥ 30 | ${s.redrawsPerSecond} (${s.minPerSecond}); draw ${s.drawMsMean} ms mean, ${s.drawMsMax} ms max | ${yes(s.redrawsPerSecond >= 30)} |`,
     ),
-    `| animation frames/s | — | ${f.frames.perSecond} | — |`,
+    `| main thread busy | — | ${f.mainThread.busyPercent} % (script ${f.mainThread.scriptPercent} %, style ${f.mainThread.stylePercent} %, layout ${f.mainThread.layoutPercent} %, paint and other ${f.mainThread.otherPercent} %) | — |`,
+    `| main thread CPU | — | ${f.cpuPercent["renderer/main"] ?? "?"} % of a core (the engine's worker ${f.cpuPercent["renderer/DedicatedWorker"] ?? "?"} %) | — |`,
+    `| page frames/s (requestAnimationFrame) | — | ${f.frames.perSecond} (panels' draw loop ${f.frames.panelLoopPerSecond}) | — |`,
     "",
     ...(f.longFrames.length
       ? [
@@ -407,6 +604,12 @@ function markdown(f: Figures): string {
           "",
         ]
       : []),
+    "CPU of Chromium's threads (% of one core): " +
+      Object.entries(f.cpuPercent)
+        .map(([k, v]) => `${k} ${v}`)
+        .join(", ") +
+      ".",
+    "",
     "Scope data: " +
       f.scopes
         .map(
@@ -424,7 +627,7 @@ function markdown(f: Figures): string {
       f.engine
         .map(
           (b) =>
-            `${b.name} ${b.status} ${round(b.rate, 1)}/${round(b.desiredRate, 1)} Hz${b.dropsIn ? `, ${b.dropsIn} dropped` : ""}`,
+            `${b.name} ${b.status} ${round(b.rate, 1)}/${round(b.desiredRate, 1)} Hz${b.dropsIn ? `, ${b.dropsIn} dropped` : ""}${b.fired !== undefined ? ` (${b.fired} ticks, ${b.missed ?? 0} missed)` : ""}`,
         )
         .join("; "),
     "",
@@ -473,6 +676,7 @@ async function main(): Promise<void> {
       const files = await screenshots(page, o, o.shots);
       console.log(`ui-bench: ${files.length} screenshots in ${o.shots}`);
     }
+    if (o.trace) await trace(browser, page, o.trace);
     f.afterClose = await checkRelease(page, o);
     const md = markdown(f);
     console.log(md);
@@ -480,9 +684,9 @@ async function main(): Promise<void> {
     if (o.write) {
       const dir = join(ROOT, "bench/results");
       mkdirSync(dir, { recursive: true });
-      writeFileSync(join(dir, "ui.json"), JSON.stringify(f, null, 2) + "\n");
-      writeFileSync(join(dir, "ui.md"), md);
-      console.log("ui-bench: wrote bench/results/ui.json and ui.md");
+      writeFileSync(join(dir, "ui-latest.json"), JSON.stringify(f, null, 2) + "\n");
+      writeFileSync(join(dir, "ui-latest.md"), md);
+      console.log("ui-bench: wrote bench/results/ui-latest.json and ui-latest.md");
     }
   } finally {
     await browser?.close();
