@@ -268,7 +268,8 @@ export class SessionHub {
           // The engine said hello once, at start; a client joining now gets it with the state.
           if (this.hello) sink.send(this.hello);
           if (this.graph) sink.send({ type: "graph", graph: this.graph });
-          if (this.lastState) sink.send(this.lastState);
+          // Always a state, so a client knows whether the engine already has a pipeline.
+          sink.send(this.lastState ?? { type: "state", state: "empty" });
           client.greeted = true;
           return;
         }

@@ -1,6 +1,8 @@
 /**
- * The browser build's entry: starts the engine in a Web Worker (simulated signals, no install)
- * and mounts the UI on it. `?pipeline=pipelines/x.yaml` picks the pipeline loaded first.
+ * The UI's entry. In the browser build it starts the engine in a Web Worker (simulated signals,
+ * no install); served by `mosaic serve` (a `?token=` in the URL) it talks to the Node host over a
+ * WebSocket; in the desktop app (a `mosaicHost` from the preload) over IPC. The last two share
+ * one engine with other windows. `?pipeline=pipelines/x.yaml` picks the pipeline loaded first.
  */
 import { createRoot } from "react-dom/client";
 import "@xyflow/react/dist/style.css";
@@ -8,9 +10,19 @@ import "../ui/styles.css";
 import { App } from "../ui/app/app";
 import { DEFAULT_PIPELINE } from "../ui/app/use-pipeline";
 import { EngineClient } from "../ui/client/engine-client";
+import { desktopHost, ipcConnection } from "../ui/client/ipc-connection";
+import { hostSocketUrl, wsConnection, type SocketLike } from "../ui/client/ws-connection";
 import { workerConnection } from "./worker-connection";
 
-const client = new EngineClient(workerConnection(new URL("./engine.worker.js", import.meta.url)));
+const desktop = desktopHost();
+const socketUrl = hostSocketUrl(window.location);
+const connection = desktop
+  ? ipcConnection(desktop)
+  : socketUrl
+    ? wsConnection(new WebSocket(socketUrl) as unknown as SocketLike)
+    : workerConnection(new URL("./engine.worker.js", import.meta.url));
+const sharedEngine = desktop !== undefined || socketUrl !== null;
+const client = new EngineClient(connection);
 // For the curious (devtools) and for end-to-end tests: the client speaks the UI protocol.
 (window as unknown as { mosaic: { client: EngineClient } }).mosaic = { client };
 
@@ -19,4 +31,6 @@ const initial = params.get("pipeline") || DEFAULT_PIPELINE;
 
 const root = document.getElementById("root");
 if (!root) throw new Error("index.html has no #root element");
-createRoot(root).render(<App client={client} initialPipeline={initial} />);
+createRoot(root).render(
+  <App client={client} initialPipeline={initial} sharedEngine={sharedEngine} />,
+);

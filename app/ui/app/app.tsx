@@ -95,7 +95,13 @@ function PipelinePicker({
   );
 }
 
-function Shell({ initialPipeline }: { initialPipeline: string }) {
+function Shell({
+  initialPipeline,
+  sharedEngine,
+}: {
+  initialPipeline: string;
+  sharedEngine: boolean;
+}) {
   const client = useEngine();
   const pipeline = usePipeline(client, initialPipeline);
   const { graph, generation } = pipeline;
@@ -265,8 +271,18 @@ function Shell({ initialPipeline }: { initialPipeline: string }) {
   useEffect(() => {
     if (started.current) return;
     started.current = true;
-    void pipeline.load(initialPipeline);
-  }, [pipeline, initialPipeline]);
+    if (!sharedEngine) {
+      void pipeline.load(initialPipeline);
+      return;
+    }
+    // A shared engine (mosaic serve, the desktop app) may already run a pipeline: its first
+    // state message (after hello and the graph, if any) tells. Show that one; else load ours.
+    const off = client.onState((st) => {
+      off();
+      if (st !== "empty" && client.graph) pipeline.adopt(client.graph);
+      else void pipeline.load(initialPipeline);
+    });
+  }, [pipeline, initialPipeline, sharedEngine, client]);
 
   const selectPipeline = (file: string): void => {
     pipeline.select(file);
@@ -463,13 +479,16 @@ function Shell({ initialPipeline }: { initialPipeline: string }) {
 export function App({
   client,
   initialPipeline,
+  sharedEngine = false,
 }: {
   client: EngineClient;
   initialPipeline: string;
+  /** The engine is shared (a Node host or the desktop app): adopt what it already runs. */
+  sharedEngine?: boolean;
 }) {
   return (
     <EngineContext.Provider value={client}>
-      <Shell initialPipeline={initialPipeline} />
+      <Shell initialPipeline={initialPipeline} sharedEngine={sharedEngine} />
     </EngineContext.Provider>
   );
 }

@@ -109,5 +109,24 @@ export function usePipeline(client: EngineClient, initial: string) {
 
   const select = useCallback((file: string) => setS((p) => ({ ...p, selected: file })), []);
 
-  return { ...s, load, loadSource, select };
+  /** Shows a pipeline the (shared) engine already has, without loading anything. */
+  const adopt = useCallback((graph: GraphInfo) => {
+    busy.current++;
+    setS((p) => ({
+      ...p,
+      loading: false,
+      file: graph.file,
+      selected: graph.file,
+      source: undefined,
+      graph,
+      generation: p.generation + 1,
+      diagnostics: [],
+      error: undefined,
+    }));
+  }, []);
+
+  // Another client of a shared engine (a tab, the desktop menu) loaded a pipeline: show it.
+  useEffect(() => client.onRemoteGraph(adopt), [client, adopt]);
+
+  return { ...s, load, loadSource, select, adopt };
 }

@@ -38,6 +38,7 @@ export class EngineClient {
   private readonly dataListeners = new Map<string, Set<DataListener>>();
   private readonly helloListeners = new Set<() => void>();
   private readonly graphListeners = new Set<(g: GraphInfo | undefined) => void>();
+  private readonly remoteGraphListeners = new Set<(g: GraphInfo) => void>();
   private readonly off: () => void;
   telemetry: Telemetry | undefined;
   state: EngineState = "empty";
@@ -79,6 +80,12 @@ export class EngineClient {
         break;
       case "data":
         for (const l of this.dataListeners.get(`${m.block}.${m.port}`) ?? []) l(m);
+        break;
+      case "graph":
+        // A pipeline this client did not load (a shared engine: another tab, the desktop menu).
+        this.graph = m.graph;
+        for (const l of this.graphListeners) l(this.graph);
+        for (const l of this.remoteGraphListeners) l(m.graph);
         break;
     }
   }
@@ -139,6 +146,12 @@ export class EngineClient {
   onGraph(l: (g: GraphInfo | undefined) => void): () => void {
     this.graphListeners.add(l);
     return () => this.graphListeners.delete(l);
+  }
+
+  /** Called when the engine announces a pipeline that this client did not load itself. */
+  onRemoteGraph(l: (g: GraphInfo) => void): () => void {
+    this.remoteGraphListeners.add(l);
+    return () => this.remoteGraphListeners.delete(l);
   }
 
   onState(l: (s: EngineState) => void): () => void {

@@ -1,0 +1,90 @@
+/**
+ * The UI served by `mosaic serve` (issue 6): the page talks to the engine in the Node process
+ * over the token-guarded WebSocket. Two tabs share the running pipeline; closing one leaves the
+ * other's graph live; a page whose token is wrong gets no engine from the host.
+ */
+import type { ChildProcess } from "node:child_process";
+import { afterAll, beforeAll, describe, expect, test } from "vitest";
+import { requireBuild, startCli } from "../integration/helpers";
+import {
+  artifact,
+  ensureWebBuild,
+  haveChromium,
+  launchChromium,
+  openApp,
+  statuses,
+  type Chromium,
+} from "./harness";
+
+describe.skipIf(!haveChromium)("mosaic serve in Chromium", () => {
+  let cli: ChildProcess;
+  let url: string;
+  let browser: Chromium;
+
+  beforeAll(async () => {
+    ensureWebBuild();
+    requireBuild();
+    cli = startCli(["serve", "pipelines/demo.yaml", "--port", "0"]);
+    let out = "";
+    url = await new Promise<string>((resolve, reject) => {
+      const t = setTimeout(() => reject(new Error(`no URL printed: ${out}`)), 20_000);
+      const seen = (d: Buffer) => {
+        out += d.toString();
+        const m = /MOSAIC is at (\S+)/.exec(out);
+        if (m) {
+          clearTimeout(t);
+          resolve(m[1]!);
+        }
+      };
+      cli.stdout!.on("data", seen);
+      cli.stderr!.on("data", (d: Buffer) => (out += d.toString()));
+    });
+    browser = await launchChromium();
+  }, 60_000);
+
+  afterAll(async () => {
+    await browser?.close();
+    if (cli && cli.exitCode === null) {
+      cli.kill("SIGINT");
+      await new Promise((r) => cli.once("exit", r));
+    }
+  });
+
+  test("two tabs show the host's running demo; closing one leaves the other live", async () => {
+    const a = await openApp(browser, url);
+    await a.page.waitForFunction(
+      `document.querySelectorAll('[data-block][data-status="ontime"]').length >= 9`,
+      undefined,
+      { timeout: 10_000 },
+    );
+    expect(await a.page.textContent("header")).toMatch(/node host|precise timing/);
+    const b = await openApp(browser, url);
+    await b.page.waitForFunction(
+      `document.querySelectorAll('[data-block][data-status="ontime"]').length >= 9`,
+      undefined,
+      { timeout: 10_000 },
+    );
+    // B did not reload the pipeline: A's page never went back to "loaded".
+    expect(Object.keys(await statuses(b.page))).toEqual(Object.keys(await statuses(a.page)));
+    await b.page.screenshot({ path: artifact("serve-second-tab.png") });
+    await a.close();
+    await new Promise((r) => setTimeout(r, 1500));
+    const s = await statuses(b.page);
+    expect(Object.values(s).filter((x) => x !== "idle").length).toBeGreaterThanOrEqual(8);
+    expect(b.errors).toEqual([]);
+    await b.close();
+  }, 60_000);
+
+  test("a wrong token gets no engine: the page says the connection closed", async () => {
+    const bad = url.replace(/token=[^&]+/, "token=wrong");
+    const p = await openApp(browser, bad, undefined, { waitRunning: false });
+    await p.page.waitForFunction(
+      `/connection to the MOSAIC host closed/.test(document.body.textContent || "")`,
+      undefined,
+      {
+        timeout: 10_000,
+      },
+    );
+    await p.close();
+  }, 30_000);
+});
