@@ -53,6 +53,7 @@ if ! python3 -m uv --version 2>/dev/null | grep -q " ${UV_VERSION}"; then
   pip_install 2>/dev/null || pip_install --break-system-packages
 fi
 python3 -m uv sync --quiet --project tests/reference --python python3.11 --frozen
+python3 -m uv sync --quiet --project native-bridges/python --python python3.11 --frozen
 
 # 5. Build the WASM core and the bundles.
 bash scripts/build.sh

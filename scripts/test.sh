@@ -29,6 +29,10 @@ cargo test --quiet --manifest-path core-wasm/Cargo.toml --workspace
 step "reference fixtures are reproduced by their committed generators"
 bash scripts/check-fixtures.sh
 
+step "python (the sidecar package and the example modules, pytest)"
+UV_PYTHON_DOWNLOADS=never python3 -m uv run --quiet --frozen --project native-bridges/python \
+  --python python3.11 python -m pytest -q -p no:cacheprovider native-bridges/python/tests pipelines/python/tests
+
 step "unit and integration tests (vitest)"
 "$bin/vitest" run
 

@@ -26,6 +26,7 @@ import { Switch } from "./flow/switch";
 import { VectorialFunction } from "./flow/vectorial-function";
 import { Ros } from "./io/ros";
 import { Myo } from "./io/myo";
+import { Python } from "./io/python";
 import { SerialPort } from "./io/serial-port";
 import { UdpReceiver } from "./io/udp-receiver";
 import { UdpSender } from "./io/udp-sender";
@@ -93,6 +94,7 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   TAC,
   BatchPredictor,
   IncrementalPredictor,
+  Python,
   // Control
   ControlAlgorithm,
   // Communication

@@ -123,6 +123,44 @@ function loopbackSerial(): FakeIo {
 }
 
 /**
+ * A Python sidecar that answers at once (synchronously, inside `call`): `Function(x, state)` adds
+ * the number of calls since `init` to every value (a state that `reset` clears); the calls are
+ * recorded.
+ */
+function instantPython(): FakeIo {
+  const calls: number[] = [];
+  return {
+    io: {
+      python: {
+        load: (o) => {
+          let n = 0;
+          let id = 0;
+          const out = new Float64Array(o.inputShape.rows * o.inputShape.cols);
+          o.onStatus("ready");
+          return Promise.resolve({
+            outputShape: o.inputShape,
+            pid: 1,
+            version: "fake",
+            ready: true,
+            call: (values) => {
+              n++;
+              calls.push(values.length);
+              for (let i = 0; i < out.length; i++) out[i] = values[i]! + n;
+              o.onResult(++id, out, 1);
+              return id;
+            },
+            reset: () => (n = 0),
+            close: () => o.onStatus("closed"),
+          });
+        },
+      },
+    },
+    recorded: () => [...calls],
+    clear: () => (calls.length = 0),
+  };
+}
+
+/**
  * A rosbridge that connects at once and loops every published message back to the subscriptions
  * of the same topic (as a ROS graph would); the messages are recorded as JSON.
  */
@@ -421,6 +459,20 @@ const SETUPS: Record<string, Setup | Setup[]> = {
     },
     // A source fed by its connection: nothing to feed here (tests/integration/ros.test.ts runs it).
     { params: { Topic: "/in", Direction: "subscribe", Channels: 2 }, inputs: [], io: loopbackRos },
+  ],
+  Python: [
+    { params: { Module: "m.py", Function: "f" }, inputs: [vec(3)], io: instantPython },
+    {
+      params: { Module: "m.py", Function: "f", Init: "init", Params: { a: 1 }, OnError: "skip" },
+      inputs: [mat(4, 2, 25)],
+      io: instantPython,
+    },
+    // Without a bridge (the browser build): loads, says so, emits nothing.
+    {
+      params: { Module: "mymodule", Function: "f", OutputShape: [1, 2] },
+      inputs: [vec(3)],
+      silent: true,
+    },
   ],
   // Setups that end idle (no capture or trial in progress): `reset` would send the stop.
   Trigger: {

@@ -117,6 +117,13 @@ export interface BlockContext {
   setText(text: string): void;
   /** A warning shown in the block's status (and printed by the CLI), rate-limited. */
   warn(message: string): void;
+  /**
+   * Reports work done for this block outside `process`, e.g. a call in the Python sidecar that
+   * `process` only handed over: `ms` joins the block's compute max (not its CPU total), and a call
+   * longer than `budgetMs` (default one period, 1 / DesiredRate) marks the block stumbling, as a
+   * measured `process` call that long would.
+   */
+  reportCompute(ms: number, budgetMs?: number): void;
   /** Declares that this (finite) source is exhausted; a run ends when all finite sources are. */
   finish(): void;
   /**

@@ -186,12 +186,81 @@ export interface BleBridge {
   connect(address: string, onDisconnect: (reason: string) => void): Promise<BleConnection>;
 }
 
+/**
+ * The Python sidecar (issue 7): one process per Python block, started by `load`, that runs the
+ * block's user function on every frame it is given (native-bridges/python.ts and
+ * native-bridges/python/, protocol in docs/protocols.md). Calls are asynchronous: `call` returns
+ * at once and the result arrives later on the worker's event loop, in call order.
+ */
+export interface PythonLoadOptions {
+  /** A `.py` file (absolute, or relative to `cwd`) or an importable module name. */
+  module: string;
+  /** The function called for every frame: `fn(x)` or `fn(x, state)`. */
+  function: string;
+  /** Called once as `init(params) -> state` at load and after `reset`. */
+  init?: string;
+  /** Passed to `init` (plain JSON). */
+  params: Record<string, unknown>;
+  /** Shape of `x` (the input events' shape). */
+  inputShape: { rows: number; cols: number };
+  /** When given, the load fails unless the function's result has as many values. */
+  outputShape?: { rows: number; cols: number };
+  /** Working directory of the process (the pipeline's folder; its modules are importable). */
+  cwd?: string;
+  /** Who asks (for messages): "block 'Net'". */
+  label: string;
+  /** A result (`values` is valid during the callback only) with the Python-side compute time. */
+  onResult(id: number, values: Float64Array, computeUs: number): void;
+  /** An exception in the user function (with its traceback), or a call lost to a crash. */
+  onError(id: number, error: PythonCallError): void;
+  /** Process life: `restarting` after a crash (with the reason), `ready` when loaded again. */
+  onStatus(state: PythonSidecarState, message?: string): void;
+  /** Lines the user code printed (stdout and stderr of the process). */
+  onOutput?(line: string): void;
+}
+
+export type PythonSidecarState = "ready" | "restarting" | "failed" | "closed";
+
+export interface PythonCallError {
+  message: string;
+  traceback: string;
+  /** `call` (an exception), `shape` (a result of another size), `crash` (the process died). */
+  kind: string;
+}
+
+export interface PythonSidecar {
+  /** The output shape found by the probe call at load. */
+  readonly outputShape: { rows: number; cols: number };
+  /** The process id of the Python interpreter (changes after a restart). */
+  readonly pid: number | undefined;
+  /** Versions the sidecar reported ("Python 3.11.7, NumPy 2.4.6"). */
+  readonly version: string;
+  /** True while a process is loaded and accepting calls. */
+  readonly ready: boolean;
+  /** Sends one input (as many values as the input shape); returns the call id, or -1 when not ready. */
+  call(values: Float64Array): number;
+  /** Calls `init` again (a fresh state); calls already sent complete first. */
+  reset(): void;
+  /** Stops the process (shutdown message, then a signal if it does not exit). */
+  close(): void;
+}
+
+export interface PythonBridge {
+  /**
+   * Starts a sidecar process and loads the module; rejects with an `Error` whose message says what
+   * is wrong (missing module, syntax error with file and line, wrong return shape, an exception in
+   * `init`), naming no block (the caller adds that).
+   */
+  load(options: PythonLoadOptions): Promise<PythonSidecar>;
+}
+
 /** Every bridge the host could provide (all optional). Issue 6 fills these in. */
 export interface IoBridges {
   udp?: UdpBridge;
   serial?: SerialBridge;
   ble?: BleBridge;
   ros?: RosBridge;
+  python?: PythonBridge;
   /** Bluetooth LE and ROS bridges are declared by their blocks' issue (6). */
   [name: string]: unknown;
 }

@@ -136,6 +136,8 @@ export class BlockHarness {
   oneShot: { t: number; fn: (t: number) => void } | null = null;
   text = "";
   warnings: string[] = [];
+  /** What the block reported through `ctx.reportCompute`. */
+  computeReports: { ms: number; budgetMs?: number }[] = [];
   readonly logs = new MemoryLogSink();
   /** Subscription state the block asked for through `ctx.setSubscribed` (by input index). */
   readonly subscribed: Record<number, boolean> = {};
@@ -247,6 +249,9 @@ export class BlockHarness {
       },
       warn(message: string) {
         h.warnings.push(message);
+      },
+      reportCompute(ms: number, budgetMs?: number) {
+        h.computeReports.push({ ms, ...(budgetMs === undefined ? {} : { budgetMs }) });
       },
       finish() {
         h.finished = true;

@@ -21,6 +21,7 @@ import { serialProxy } from "../../native-bridges/serial-proxy";
 import { bleProxy } from "../../native-bridges/ble-proxy";
 import { nodeRosBridge } from "../../native-bridges/ros";
 import { nodeUdpBridge } from "../../native-bridges/udp";
+import { createPythonBridge } from "../../native-bridges/python";
 import { nodeResources } from "./resources";
 import { clockFromBase } from "./time-base";
 import type { HostToWorker, InitMessage, WorkerToHost } from "./worker-protocol";
@@ -102,7 +103,13 @@ async function create(msg: InitMessage): Promise<void> {
     clock,
     virtual,
     resources: nodeResources(dirname(msg.file)),
-    io: { udp: nodeUdpBridge(), ros: nodeRosBridge(), serial: serial.bridge, ble: ble.bridge },
+    io: {
+      udp: nodeUdpBridge(),
+      ros: nodeRosBridge(),
+      serial: serial.bridge,
+      ble: ble.bridge,
+      python: createPythonBridge(),
+    },
     logs: sabLogSink(virtual),
     worker: msg.worker,
     ...(msg.plan ? { plan: msg.plan } : {}),

@@ -21,6 +21,7 @@ import { bleProxy } from "../../native-bridges/ble-proxy";
 import { nodeRosBridge } from "../../native-bridges/ros";
 import { serialProxy } from "../../native-bridges/serial-proxy";
 import { nodeUdpBridge } from "../../native-bridges/udp";
+import { createPythonBridge } from "../../native-bridges/python";
 import { nodeResources } from "./resources";
 import { clockFromBase } from "./time-base";
 import type { HubToSession, SessionToHub } from "./session-protocol";
@@ -102,7 +103,13 @@ function boot(msg: Extract<HubToSession, { type: "session-init" }>): void {
     clock: () => clockFromBase(msg.timeBase) as MonotonicClock,
     resources: (file) => nodeResources(folderOf(file)),
     logs: (file) => logSink(file),
-    io: { udp: nodeUdpBridge(), ros: nodeRosBridge(), serial: serial.bridge, ble: ble.bridge },
+    io: {
+      udp: nodeUdpBridge(),
+      ros: nodeRosBridge(),
+      serial: serial.bridge,
+      ble: ble.bridge,
+      python: createPythonBridge(),
+    },
     startLoop,
     post: (m, transfer) => post(m, transfer),
   });

@@ -343,6 +343,59 @@ describe("status", () => {
     });
   });
 
+  test("work reported outside process (a sidecar call) counts toward stumbling, not the CPU total", () => {
+    const s = new StatusTracker(100);
+    for (let i = 0; i < 100; i++) s.record(frameAt(i / 100), i / 100);
+    s.external(9, 0.5); // within one period
+    expect(s.evaluate(0.99).status).toBe("ontime");
+    s.external(4, 0.6, 3); // beyond its own budget
+    expect(s.evaluate(0.99).status).toBe("stumbling");
+    expect(s.computeMaxWindow).toBe(9);
+    expect(s.calls).toBe(0);
+    expect(s.computeTotal).toBe(0);
+    const t = new StatusTracker(100);
+    for (let i = 0; i < 100; i++) t.record(frameAt(i / 100), i / 100);
+    t.external(10.5, 0.5);
+    expect(t.evaluate(0.99)).toMatchObject({ status: "stumbling", stumbling: true });
+  });
+
+  test("ctx.reportCompute reaches the block's status", async () => {
+    const Reporter = defineBlock({
+      type: "Reporter",
+      category: "Testing",
+      summary: "reports",
+      help: "reports a 25 ms compute for every event, like a slow sidecar call",
+      params: z.strictObject({}),
+      inputs: { min: 1, max: 1 },
+      create(ctx) {
+        const out = ctx.output(vectorShape(1));
+        return {
+          process(f) {
+            ctx.reportCompute(25);
+            const o = out.frame(f.n);
+            o.copyEvents(f, 0, f.n, 0);
+            out.emit(o);
+          },
+        };
+      },
+    });
+    const catalog = createCatalog([...TEST_BLOCKS, Reporter]);
+    const run = await runVirtualPipeline(
+      `
+Timer: { Type: Tick, DesiredRate: 100 }
+Src: { Type: Counter, Inputs: [Timer] }
+Slow: { Type: Reporter, Inputs: [Src] }
+Fast: { Type: Reporter, Inputs: [Src], DesiredRate: 20 }
+`,
+      { catalog, duration: 2 },
+    );
+    const by = Object.fromEntries(run.telemetry.blocks.map((b) => [b.name, b]));
+    expect(by.Slow!.status).toBe("stumbling");
+    expect(by.Slow!.computeMaxMs).toBe(25);
+    expect(by.Src!.status).toBe("ontime");
+    expect(by.Fast!.status).toBe("ontime"); // 25 ms within its 50 ms period
+  });
+
   test("idle before the first output; a pause does not read as lagging afterwards", () => {
     const s = new StatusTracker(100);
     expect(s.evaluate(0).status).toBe("idle");

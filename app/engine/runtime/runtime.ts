@@ -590,6 +590,9 @@ export class Runtime {
       warn(message: string) {
         rt.warn(node, message);
       },
+      reportCompute(ms: number, budgetMs?: number) {
+        node.status.external(ms, rt.clock.now(), budgetMs);
+      },
       setSubscribed(index: number, subscribed: boolean): boolean {
         const e = node.inEdges.find((x) => x.toIndex === index);
         if (!e) return false;

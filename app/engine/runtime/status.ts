@@ -102,6 +102,18 @@ export class StatusTracker {
     if (this.desiredRate > 0 && ms > 1000 / this.desiredRate) this.lastOverrunWall = now;
   }
 
+  /**
+   * Records work done for the block elsewhere (a sidecar call, reported by the block): it shows in
+   * the compute max and, beyond `budgetMs` (default one period), marks stumbling; it does not count
+   * as a call nor toward the worker's CPU total.
+   */
+  external(ms: number, now: number, budgetMs?: number): void {
+    this.computeLast = ms;
+    if (ms > this.computeMaxWindow) this.computeMaxWindow = ms;
+    const limit = budgetMs ?? (this.desiredRate > 0 ? 1000 / this.desiredRate : Infinity);
+    if (ms > limit) this.lastOverrunWall = now;
+  }
+
   /** Rate over the window, Hz (NaN with fewer than two outputs). */
   rate(): number {
     const n = this.inWindow;

@@ -1,0 +1,580 @@
+/**
+ * The Python sidecar bridge for Node hosts (`ctx.io.python`). Every Python block gets its own
+ * process (`python -m mosaic_sidecar` in the uv environment of native-bridges/python, started with
+ * `python3 -m uv run --frozen …`, never downloading an interpreter), so one slow or crashing block
+ * never stalls another, and the engine never waits on any of them: `call` writes one framed message
+ * to the process's stdin and returns; the result arrives on the worker's event loop. A process that
+ * dies (a crash, `kill -9`, an out-of-memory kill) is reported and started again with backoff
+ * (0.5 s doubling to 10 s), its module loaded again with a fresh state. The wire format is in
+ * docs/protocols.md ("Python sidecar") and native-bridges/python/mosaic_sidecar/protocol.py.
+ *
+ * `MOSAIC_PYTHON=/path/to/python` runs that interpreter instead of the uv environment (it needs
+ * NumPy, and whatever the user's modules import).
+ */
+import { spawn, type ChildProcess } from "node:child_process";
+import { existsSync } from "node:fs";
+import { delimiter, dirname, join } from "node:path";
+import { fileURLToPath } from "node:url";
+import type {
+  PythonBridge,
+  PythonCallError,
+  PythonLoadOptions,
+  PythonSidecar,
+} from "../app/engine/io";
+
+export const MAGIC = 0x5950534d;
+export const VERSION = 1;
+export const HEADER_SIZE = 16;
+export const MSG = {
+  hello: 1,
+  load: 2,
+  ok: 3,
+  error: 4,
+  call: 5,
+  result: 6,
+  reset: 7,
+  shutdown: 8,
+} as const;
+const MAX_PAYLOAD = 1 << 30;
+
+/** A load failure; `kind` says which param is at fault (missing-module, syntax, shape, …). */
+export class PythonLoadError extends Error {
+  constructor(
+    message: string,
+    readonly kind: string,
+    readonly traceback = "",
+  ) {
+    super(message);
+    this.name = "PythonLoadError";
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Framing (little-endian; every supported host is)
+
+export function encodeMessage(type: number, id: number, payload?: Uint8Array): Buffer {
+  const len = payload?.byteLength ?? 0;
+  const b = Buffer.allocUnsafe(HEADER_SIZE + len);
+  b.writeUInt32LE(MAGIC, 0);
+  b.writeUInt16LE(VERSION, 4);
+  b.writeUInt16LE(type, 6);
+  b.writeUInt32LE(id >>> 0, 8);
+  b.writeUInt32LE(len, 12);
+  if (payload) b.set(payload, HEADER_SIZE);
+  return b;
+}
+
+const arrayPrefix = (ndim: number): number => (4 + 4 * ndim + 7) & ~7;
+
+/** A `call` message: the header, then `values` as an f64 array of shape [rows, cols]. */
+export function encodeCall(id: number, values: Float64Array, rows: number, cols: number): Buffer {
+  const pre = arrayPrefix(2);
+  const len = pre + values.byteLength;
+  const b = Buffer.alloc(HEADER_SIZE + len);
+  b.writeUInt32LE(MAGIC, 0);
+  b.writeUInt16LE(VERSION, 4);
+  b.writeUInt16LE(MSG.call, 6);
+  b.writeUInt32LE(id >>> 0, 8);
+  b.writeUInt32LE(len, 12);
+  b.writeUInt8(1, 16); // f64
+  b.writeUInt8(2, 17); // ndim
+  b.writeUInt32LE(rows, 20);
+  b.writeUInt32LE(cols, 24);
+  b.set(new Uint8Array(values.buffer, values.byteOffset, values.byteLength), HEADER_SIZE + pre);
+  return b;
+}
+
+/**
+ * Decodes the array at `offset` of `payload` into `out` (bit for bit for f64); returns the number
+ * of values, or a string saying what is wrong.
+ */
+export function decodeArrayInto(
+  payload: Buffer,
+  offset: number,
+  out: Float64Array,
+): number | string {
+  if (payload.length - offset < 4) return "array header truncated";
+  const dtype = payload.readUInt8(offset);
+  const ndim = payload.readUInt8(offset + 1);
+  const pre = arrayPrefix(ndim);
+  if (payload.length - offset < pre) return "array shape truncated";
+  let count = 1;
+  for (let i = 0; i < ndim; i++) count *= payload.readUInt32LE(offset + 4 + 4 * i);
+  const size = dtype === 1 ? 8 : dtype === 2 ? 4 : 0;
+  if (size === 0) return `unknown dtype code ${dtype}`;
+  const start = offset + pre;
+  if (payload.length - start !== count * size) return "array length does not match its shape";
+  if (count !== out.length) return `${count} values, expected ${out.length}`;
+  if (size === 8) {
+    new Uint8Array(out.buffer, out.byteOffset, out.byteLength).set(
+      payload.subarray(start, start + count * 8),
+    );
+  } else {
+    for (let i = 0; i < count; i++) out[i] = payload.readFloatLE(start + 4 * i);
+  }
+  return count;
+}
+
+/** Splits a byte stream into messages. */
+export class MessageReader {
+  private buf: Buffer = Buffer.alloc(0);
+
+  constructor(private readonly onMessage: (type: number, id: number, payload: Buffer) => void) {}
+
+  /** Feeds bytes; returns an error text when the stream is corrupt (then stop reading). */
+  push(chunk: Buffer): string | undefined {
+    this.buf = this.buf.length === 0 ? chunk : Buffer.concat([this.buf, chunk]);
+    for (;;) {
+      const b = this.buf;
+      if (b.length < HEADER_SIZE) return undefined;
+      if (b.readUInt32LE(0) !== MAGIC) {
+        return `bad magic in the sidecar's output (${JSON.stringify(b.subarray(0, 16).toString("latin1"))}…)`;
+      }
+      if (b.readUInt16LE(4) !== VERSION) return `sidecar speaks protocol ${b.readUInt16LE(4)}`;
+      const len = b.readUInt32LE(12);
+      if (len > MAX_PAYLOAD) return `message of ${len} bytes`;
+      if (b.length < HEADER_SIZE + len) return undefined;
+      const payload = b.subarray(HEADER_SIZE, HEADER_SIZE + len);
+      this.buf = b.subarray(HEADER_SIZE + len);
+      this.onMessage(b.readUInt16LE(6), b.readUInt32LE(8), payload);
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Processes
+
+export interface SidecarCommand {
+  file: string;
+  args: string[];
+  env: Record<string, string>;
+}
+
+export interface PythonBridgeOptions {
+  /** The repository root (holds native-bridges/python); found from this file by default. */
+  root?: string;
+  /** How to start a sidecar (tests); default: uv run in native-bridges/python. */
+  command?: (cwd: string) => SidecarCommand;
+  /** First restart delay and its cap (ms). */
+  backoffMs?: { first: number; max: number };
+  /** How long a start (hello + load, imports included) may take. */
+  loadTimeoutMs?: number;
+}
+
+function repoRoot(): string {
+  let d = dirname(fileURLToPath(import.meta.url));
+  for (let i = 0; i < 6; i++) {
+    if (existsSync(join(d, "native-bridges", "python", "pyproject.toml"))) return d;
+    d = dirname(d);
+  }
+  return process.cwd();
+}
+
+/** The default command: the uv environment of native-bridges/python (or `MOSAIC_PYTHON`). */
+export function defaultCommand(root: string): (cwd: string) => SidecarCommand {
+  const project = join(root, "native-bridges", "python");
+  return (cwd) => {
+    const pythonPath = [project, cwd, process.env.PYTHONPATH].filter(Boolean).join(delimiter);
+    const env = { PYTHONPATH: pythonPath, PYTHONUNBUFFERED: "1", UV_PYTHON_DOWNLOADS: "never" };
+    const own = process.env.MOSAIC_PYTHON;
+    if (own) return { file: own, args: ["-m", "mosaic_sidecar"], env };
+    return {
+      file: process.env.MOSAIC_PYTHON3 ?? "python3",
+      args: [
+        "-m",
+        "uv",
+        "run",
+        "--quiet",
+        "--frozen",
+        "--project",
+        project,
+        "--python",
+        "python3.11",
+        "python",
+        "-m",
+        "mosaic_sidecar",
+      ],
+      env,
+    };
+  };
+}
+
+interface Control {
+  resolve: (payload: Buffer, type: number) => void;
+}
+
+/** One process: spawn, framed messages, control requests as promises. */
+class Proc {
+  readonly child: ChildProcess;
+  private readonly reader: MessageReader;
+  private readonly control = new Map<number, Control>();
+  private stderrTail: string[] = [];
+  private partialLine = "";
+  exited = false;
+  exitReason = "";
+  pid: number | undefined;
+
+  constructor(
+    cmd: SidecarCommand,
+    cwd: string,
+    private readonly onCall: (type: number, id: number, payload: Buffer) => void,
+    private readonly onLine: (line: string) => void,
+    private readonly onExit: (reason: string) => void,
+  ) {
+    this.reader = new MessageReader((type, id, payload) => {
+      const c = this.control.get(id);
+      if (c) {
+        this.control.delete(id);
+        c.resolve(payload, type);
+      } else {
+        this.onCall(type, id, payload);
+      }
+    });
+    this.child = spawn(cmd.file, cmd.args, {
+      cwd,
+      env: { ...process.env, ...cmd.env },
+      stdio: ["pipe", "pipe", "pipe"],
+    });
+    this.child.stdout!.on("data", (d: Buffer) => {
+      const problem = this.reader.push(d);
+      if (problem) {
+        this.exitReason = `protocol error: ${problem}`;
+        this.kill();
+      }
+    });
+    this.child.stderr!.on("data", (d: Buffer) => {
+      const text = this.partialLine + d.toString("utf8");
+      const lines = text.split(/\r?\n/);
+      this.partialLine = lines.pop() ?? "";
+      for (const l of lines) {
+        if (l.trim() === "") continue;
+        this.stderrTail.push(l);
+        if (this.stderrTail.length > 40) this.stderrTail.shift();
+        this.onLine(l);
+      }
+    });
+    this.child.stdin!.on("error", () => {}); // EPIPE after a crash: the exit event reports it
+    this.child.on("error", (e) => this.finish(`cannot start ${cmd.file}: ${e.message}`));
+    this.child.on("exit", (code, signal) =>
+      this.finish(signal ? `killed by ${signal}` : `exited with code ${code}`),
+    );
+  }
+
+  private finish(reason: string): void {
+    if (this.exited) return;
+    this.exited = true;
+    if (!this.exitReason) this.exitReason = reason;
+    for (const c of this.control.values()) c.resolve(Buffer.alloc(0), -1);
+    this.control.clear();
+    this.onExit(this.exitReason);
+  }
+
+  stderr(lines = 12): string {
+    const tail = this.partialLine ? [...this.stderrTail, this.partialLine] : this.stderrTail;
+    return tail.slice(-lines).join("\n");
+  }
+
+  write(b: Buffer): void {
+    if (!this.exited) this.child.stdin!.write(b);
+  }
+
+  request(type: number, id: number, json?: unknown): Promise<{ type: number; payload: Buffer }> {
+    return new Promise((resolve) => {
+      this.control.set(id, { resolve: (payload, t) => resolve({ type: t, payload }) });
+      this.write(
+        encodeMessage(type, id, json === undefined ? undefined : Buffer.from(JSON.stringify(json))),
+      );
+    });
+  }
+
+  /** Asks the process to stop: shutdown, end of input, then signals if it lingers. */
+  stop(): void {
+    if (this.exited) return;
+    try {
+      this.child.stdin!.write(encodeMessage(MSG.shutdown, 0));
+      this.child.stdin!.end();
+    } catch {
+      // already gone
+    }
+    const term = setTimeout(() => {
+      if (!this.exited) this.child.kill("SIGTERM");
+    }, 2000);
+    const kill = setTimeout(() => {
+      if (!this.exited) this.kill();
+    }, 5000);
+    term.unref();
+    kill.unref();
+  }
+
+  kill(): void {
+    try {
+      this.child.kill("SIGKILL");
+    } catch {
+      // gone
+    }
+  }
+}
+
+function parseJson(b: Buffer): Record<string, unknown> {
+  try {
+    return JSON.parse(b.toString("utf8")) as Record<string, unknown>;
+  } catch {
+    return { message: b.toString("utf8") };
+  }
+}
+
+const formatS = (ms: number): string => `${ms % 1000 === 0 ? ms / 1000 : (ms / 1000).toFixed(1)} s`;
+
+export function createPythonBridge(options: PythonBridgeOptions = {}): PythonBridge {
+  const root = options.root ?? repoRoot();
+  const command = options.command ?? defaultCommand(root);
+  const backoff = options.backoffMs ?? { first: 500, max: 10_000 };
+  const loadTimeoutMs = options.loadTimeoutMs ?? 120_000;
+  return {
+    load: (o) => startSidecar(o, command, backoff, loadTimeoutMs),
+  };
+}
+
+async function startSidecar(
+  o: PythonLoadOptions,
+  command: (cwd: string) => SidecarCommand,
+  backoff: { first: number; max: number },
+  loadTimeoutMs: number,
+): Promise<PythonSidecar> {
+  const cwd = o.cwd ?? process.cwd();
+  let nextId = 1;
+  const id = (): number => {
+    const i = nextId;
+    nextId = nextId >= 0xfffffff0 ? 1 : nextId + 1;
+    return i;
+  };
+  let proc: Proc | undefined;
+  let ready = false;
+  let closed = false;
+  let version = "";
+  let outputShape = { rows: 1, cols: 1 };
+  let outSize = 1;
+  let out = new Float64Array(1);
+  /** Calls sent to the current process and not answered yet, oldest first. */
+  const inFlight: number[] = [];
+  let delay = backoff.first;
+  let readySince = 0;
+  let retry: ReturnType<typeof setTimeout> | undefined;
+
+  const onCall = (type: number, callId: number, payload: Buffer): void => {
+    const k = inFlight.indexOf(callId);
+    if (k >= 0) inFlight.splice(k, 1);
+    if (closed) return;
+    if (type === MSG.result) {
+      const us = payload.length >= 8 ? payload.readDoubleLE(0) : NaN;
+      const n = decodeArrayInto(payload, 8, out);
+      if (typeof n === "string") {
+        o.onError(callId, {
+          message: `bad result from the sidecar: ${n}`,
+          traceback: "",
+          kind: "protocol",
+        });
+      } else {
+        o.onResult(callId, out, us);
+      }
+    } else if (type === MSG.error) {
+      const e = parseJson(payload);
+      const err: PythonCallError = {
+        message: String(e.message ?? "error"),
+        traceback: String(e.traceback ?? ""),
+        kind: String(e.kind ?? "call"),
+      };
+      if (err.kind === "init" && callId === 0) o.onError(0, err);
+      else o.onError(callId, err);
+    }
+  };
+
+  /** Starts a process and loads the module; resolves when ready, rejects with a PythonLoadError. */
+  const launch = async (): Promise<void> => {
+    const cmd = command(cwd);
+    const p = new Proc(
+      cmd,
+      cwd,
+      (type, callId, payload) => {
+        if (p === proc) onCall(type, callId, payload);
+      },
+      (line) => {
+        if (p === proc && !closed) o.onOutput?.(line);
+      },
+      (reason) => {
+        // While loading, `launch` itself fails (and its caller decides); once ready, a restart.
+        if (p === proc && ready) crashed(reason);
+      },
+    );
+    proc = p;
+    let timer: ReturnType<typeof setTimeout> | undefined;
+    const timeout = new Promise<never>((_, reject) => {
+      timer = setTimeout(() => {
+        reject(
+          new PythonLoadError(
+            `the Python sidecar did not load ${o.module} within ${formatS(loadTimeoutMs)}`,
+            "start",
+          ),
+        );
+      }, loadTimeoutMs);
+    });
+    const startFailed = (what: string): PythonLoadError => {
+      const tail = p.stderr();
+      const hint = /No module named uv|uv: not found|ENOENT|No interpreter found|python3\.11/.test(
+        `${p.exitReason}\n${tail}`,
+      )
+        ? " (install uv and the environment with scripts/setup.sh; Python 3.11 must be on the PATH)"
+        : "";
+      return new PythonLoadError(
+        `the Python sidecar ${what}: ${p.exitReason}${tail ? `\n${tail}` : ""}${hint}`,
+        "start",
+      );
+    };
+    const sequence = async (): Promise<void> => {
+      const h = await p.request(MSG.hello, id());
+      if (h.type !== MSG.hello) throw startFailed("did not start");
+      const info = parseJson(h.payload);
+      version = `Python ${String(info.python)}, NumPy ${String(info.numpy)}`;
+      p.pid = typeof info.pid === "number" ? info.pid : p.child.pid;
+      const l = await p.request(MSG.load, id(), {
+        module: o.module,
+        function: o.function,
+        init: o.init ?? null,
+        params: o.params,
+        input_shape: [o.inputShape.rows, o.inputShape.cols],
+        output_shape: o.outputShape ? [o.outputShape.rows, o.outputShape.cols] : null,
+        cwd,
+      });
+      if (l.type === MSG.error) {
+        const e = parseJson(l.payload);
+        throw new PythonLoadError(
+          String(e.message ?? "load failed"),
+          String(e.kind ?? "load"),
+          String(e.traceback ?? ""),
+        );
+      }
+      if (l.type !== MSG.ok) throw startFailed("stopped while loading");
+      const shape = parseJson(l.payload).output_shape as [number, number];
+      outputShape = { rows: shape[0], cols: shape[1] };
+      if (shape[0] * shape[1] !== outSize || out.length !== shape[0] * shape[1]) {
+        outSize = shape[0] * shape[1];
+        out = new Float64Array(outSize);
+      }
+    };
+    try {
+      await Promise.race([sequence(), timeout]);
+    } catch (e) {
+      if (proc === p) proc = undefined;
+      p.stop();
+      throw e;
+    } finally {
+      clearTimeout(timer);
+    }
+  };
+
+  const crashed = (reason: string): void => {
+    const p = proc;
+    proc = undefined;
+    const wasReady = ready;
+    ready = false;
+    if (closed) return;
+    const lost = inFlight.splice(0);
+    const tail = p?.stderr(6) ?? "";
+    for (const callId of lost) {
+      o.onError(callId, {
+        message: `the Python process died (${reason})`,
+        traceback: tail,
+        kind: "crash",
+      });
+    }
+    if (wasReady && performance.now() - readySince > backoff.max) delay = backoff.first;
+    o.onStatus(
+      "restarting",
+      `the Python process (pid ${p?.pid ?? "?"}) ${reason}; restarting in ${formatS(delay)}`,
+    );
+    scheduleRestart();
+  };
+
+  const scheduleRestart = (): void => {
+    if (closed || retry) return;
+    const wait = delay;
+    delay = Math.min(delay * 2, backoff.max);
+    retry = setTimeout(() => {
+      retry = undefined;
+      if (closed) return;
+      launch().then(
+        () => {
+          if (closed) {
+            proc?.stop();
+            return;
+          }
+          ready = true;
+          readySince = performance.now();
+          o.onStatus("ready", `restarted (pid ${proc?.pid ?? "?"})`);
+        },
+        (e: unknown) => {
+          if (closed) return;
+          o.onStatus(
+            "restarting",
+            `restart failed: ${(e as Error).message.split("\n")[0]}; retrying in ${formatS(delay)}`,
+          );
+          scheduleRestart();
+        },
+      );
+    }, wait);
+    retry.unref?.();
+  };
+
+  await launch();
+  ready = true;
+  readySince = performance.now();
+  o.onStatus("ready");
+
+  return {
+    get outputShape() {
+      return outputShape;
+    },
+    get pid() {
+      return proc?.pid;
+    },
+    get version() {
+      return version;
+    },
+    get ready() {
+      return ready && !closed;
+    },
+    call(values: Float64Array): number {
+      const p = proc;
+      if (!ready || closed || !p) return -1;
+      const callId = id();
+      inFlight.push(callId);
+      p.write(encodeCall(callId, values, o.inputShape.rows, o.inputShape.cols));
+      return callId;
+    },
+    reset() {
+      const p = proc;
+      if (!ready || closed || !p) return;
+      void p.request(MSG.reset, id()).then(({ type, payload }) => {
+        if (type === MSG.error && !closed) {
+          const e = parseJson(payload);
+          o.onError(0, {
+            message: `init raised on reset: ${String(e.message)}`,
+            traceback: String(e.traceback ?? ""),
+            kind: "init",
+          });
+        }
+      });
+    },
+    close() {
+      if (closed) return;
+      closed = true;
+      ready = false;
+      if (retry) clearTimeout(retry);
+      retry = undefined;
+      const p = proc;
+      proc = undefined;
+      p?.stop();
+      o.onStatus("closed");
+    },
+  };
+}
