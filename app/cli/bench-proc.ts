@@ -29,6 +29,9 @@ export interface CpuSample {
   nsPct: number;
   /** VmRSS at the end of the sample, KiB. */
   rssKiB: number;
+  /** CPU % of one core of the child's own child processes (e.g. Python sidecars), from their
+   * /proc/<pid>/stat; 0 when it has none. */
+  childrenPct: number;
   /** After the warm-up (steady state)? */
   steady: boolean;
 }
@@ -158,10 +161,49 @@ interface CpuMark {
   at: number;
   ticks: number;
   ns: Map<string, number> | undefined;
+  /** utime + stime of every descendant process, ticks, by pid. */
+  children: Map<number, number>;
+}
+
+/** Every descendant of `pid` (children of all its threads, recursively). */
+function descendants(pid: number, out: number[] = []): number[] {
+  let tids: string[];
+  try {
+    tids = readdirSync(`/proc/${pid}/task`);
+  } catch {
+    return out;
+  }
+  for (const tid of tids) {
+    let kids: string;
+    try {
+      kids = readFileSync(`/proc/${pid}/task/${tid}/children`, "utf8");
+    } catch {
+      continue;
+    }
+    for (const k of kids.split(" ")) {
+      const c = Number(k);
+      if (Number.isInteger(c) && c > 0 && !out.includes(c)) {
+        out.push(c);
+        descendants(c, out);
+      }
+    }
+  }
+  return out;
+}
+
+function childrenDelta(a: Map<number, number>, b: Map<number, number>): number {
+  let d = 0;
+  for (const [pid, v] of b) d += Math.max(0, v - (a.get(pid) ?? 0));
+  return d;
 }
 
 function mark(pid: number, at: number): CpuMark {
-  return { at, ticks: readStatTicks(pid), ns: readTaskNs(pid) };
+  const children = new Map<number, number>();
+  for (const c of descendants(pid)) {
+    const t = readStatTicks(c);
+    if (Number.isFinite(t)) children.set(c, t);
+  }
+  return { at, ticks: readStatTicks(pid), ns: readTaskNs(pid), children };
 }
 
 function nsDelta(a: Map<string, number> | undefined, b: Map<string, number> | undefined): number {
@@ -236,6 +278,7 @@ export function runChild(o: ChildOptions): Promise<ChildRun> {
           ticksPct: ((cur.ticks - last.ticks) / tck / dt) * 100,
           nsPct: (nsDelta(last.ns, cur.ns) / 1e9 / dt) * 100,
           rssKiB: readStatusKiB(pid, "VmRSS"),
+          childrenPct: (childrenDelta(last.children, cur.children) / tck / dt) * 100,
           steady,
         });
         const hwm = readStatusKiB(pid, "VmHWM");

@@ -26,6 +26,8 @@ export interface BlockRow {
   /** Events dropped on the edges into the block during the measured interval. */
   dropsIn: number;
   shares: StatusShares | null;
+  /** The block's status line at the end of the run (Python blocks: call times, over budget). */
+  text?: string;
 }
 
 export interface TimerFigures {
@@ -51,6 +53,9 @@ export interface CpuFigures {
   /** The same from /proc/<pid>/stat ticks (1 tick = 1/CLK_TCK s, i.e. 1 % in a 1-s sample). */
   ticksMedianPct: number;
   ticksMeanPct: number;
+  /** Child processes of the run (Python sidecars): median and mean % of one core; 0 without. */
+  childrenMedianPct: number;
+  childrenMeanPct: number;
   clkTck: number;
   /** Steady-state CPU of each thread (schedstat; busiest first; threads under 0.05 % left out).
    * `main` is the CLI's main thread; the others are named by tid (Node names them all "node"). */
@@ -684,6 +689,12 @@ export function pipelineMarkdown(r: PipelineResult, heading = "###"): string[] {
         `median ${fmtPct(c.medianPct)}, p90 ${fmtPct(c.p90Pct)}, mean ${fmtPct(c.meanPct)} ± ${fmtPct(c.stdPct)} ` +
         `over ${c.samples} 1-s samples (from /proc/<pid>/stat ticks: median ${fmtPct(c.ticksMedianPct)}, mean ${fmtPct(c.ticksMeanPct)})`,
     );
+    if (c.childrenMeanPct > 0) {
+      res.push(
+        `Child processes (Python sidecars; not in the figure above): median ${fmtPct(c.childrenMedianPct)}, ` +
+          `mean ${fmtPct(c.childrenMeanPct)} of one core`,
+      );
+    }
     if (Number.isFinite(r.blocksComputePct)) {
       res.push(
         `Blocks' own compute (Σ of measured \`process\` time): ${fmtPct(r.blocksComputePct)} of one core; ` +
@@ -718,6 +729,13 @@ export function pipelineMarkdown(r: PipelineResult, heading = "###"): string[] {
     `Drops on edges: ${r.drops} after the warm-up (${r.dropsAllTime} in all); start-up (process start to ` +
       `pipeline running) ${r.loadSeconds.toFixed(2)} s`,
   );
+  for (const b of r.blocks) {
+    if (b.type === "Python" && b.text) {
+      res.push(
+        `Python block ${b.name} at the end (sidecar round trip, then Python's own time): ${b.text}`,
+      );
+    }
+  }
   if (r.warnings.length) res.push(`Warnings: ${r.warnings.join("; ")}`);
   for (const l of res) out.push(`- ${l}`);
   out.push("");

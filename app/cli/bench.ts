@@ -62,7 +62,7 @@ Markdown tables and writes DIR/latest.json and DIR/latest.md (default DIR: bench
   --duration S  steady-state seconds per pipeline after the warm-up (default 30; the timer
                 workloads use half, at least 2)
   --warmup S    seconds excluded at the start of each real-time run (default 5)
-  --only LIST   run only these workloads: ${"myo, delsys, hdemg, hdemg-features, timer, timer-precision, replay-32, replay-256, learn, udp"}
+  --only LIST   run only these workloads: ${"myo, delsys, hdemg, hdemg-features, timer, timer-precision, replay-32, replay-256, learn, udp, python-cnn"}
                 (a prefix before '-' selects a group: timer, replay); learn is the
                 micro-benchmark of the learning kernels (ns per update and prediction)
   --out DIR     where to write latest.json and latest.md
@@ -131,6 +131,13 @@ const WORKLOADS: WorkloadDef[] = [
     id: "hdemg-features",
     title: "(d) High-density EMG features — 256 ch @ 2048 Hz, 200 ms windows every 25 ms",
     file: "hdemg-features.yaml",
+  },
+  {
+    kind: "pipeline",
+    id: "python-cnn",
+    title:
+      "(e) Deep model in the Python sidecar — 32 ch @ 1926 Hz, 200-sample windows every 77 (25 Hz), ONNX 1-D CNN, control, UDP",
+    file: "python-cnn.yaml",
   },
   {
     kind: "pipeline",
@@ -246,6 +253,13 @@ function cpuFigures(run: ChildRun, useNs: boolean): CpuFigures | null {
     stdPct: round(std(pick)),
     ticksMedianPct: round(quantile(ticks, 0.5)),
     ticksMeanPct: round(mean(ticks)),
+    childrenMedianPct: round(
+      quantile(
+        steady.map((s) => s.childrenPct),
+        0.5,
+      ),
+    ),
+    childrenMeanPct: round(mean(steady.map((s) => s.childrenPct))),
     clkTck: clkTck(),
     threads: run.threads
       .filter((t) => t.pct >= 0.05)
@@ -281,6 +295,7 @@ function blockRows(run: ChildRun): BlockRow[] {
       computeMeanUs: tm.calls > 0 ? (tm.computeTotalMs / tm.calls) * 1000 : NaN,
       calls: tm.calls,
       dropsIn: b.dropsIn - (base.get(b.name)?.dropsIn ?? 0),
+      ...(b.text ? { text: b.text } : {}),
       shares:
         c && n > 0
           ? {
