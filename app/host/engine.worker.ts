@@ -22,7 +22,7 @@ import { bleProxy } from "../../native-bridges/ble-proxy";
 import { nodeRosBridge } from "../../native-bridges/ros";
 import { nodeUdpBridge } from "../../native-bridges/udp";
 import { createPythonBridge } from "../../native-bridges/python";
-import { nodeResources } from "./resources";
+import { flushWrites, nodeResources } from "./resources";
 import { clockFromBase } from "./time-base";
 import type { HostToWorker, InitMessage, WorkerToHost } from "./worker-protocol";
 
@@ -186,7 +186,8 @@ function stop(): void {
     rt.dispatch();
     const telemetry = rt.telemetry();
     rt.dispose();
-    post({ type: "stopped", telemetry });
+    // Files the blocks are still writing (a model saved at the end) land before the host ends us.
+    void flushWrites().then(() => post({ type: "stopped", telemetry }));
   } else {
     post({
       type: "stopped",

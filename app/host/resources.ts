@@ -1,6 +1,70 @@
-import { mkdir, readFile, writeFile } from "node:fs/promises";
+import { mkdir, readFile, rename, rm, writeFile } from "node:fs/promises";
 import { dirname, isAbsolute, resolve } from "node:path";
 import type { Resources } from "../engine/block";
+
+/**
+ * Writes by file. Writes to one file never overlap (two overlapping `writeFile`s to the same
+ * path can leave the tail of the longer text behind the shorter one), and while one is in
+ * flight only the newest waiting text is kept: a model saved ten times in a burst is written at
+ * most twice, the last time with the last text.
+ */
+interface FileQueue {
+  running: Promise<void>;
+  next?: { text: string; waiters: { resolve(): void; reject(e: unknown): void }[] };
+}
+const queues = new Map<string, FileQueue>();
+let tmpSeq = 0;
+
+/** Writes `text` to `full` atomically: a temporary file beside it, then a rename. */
+async function writeAtomic(full: string, text: string): Promise<void> {
+  await mkdir(dirname(full), { recursive: true });
+  const tmp = `${full}.${process.pid}.${tmpSeq++}.tmp`;
+  try {
+    await writeFile(tmp, text, "utf8");
+    await rename(tmp, full);
+  } catch (e) {
+    await rm(tmp, { force: true }).catch(() => {});
+    throw e;
+  }
+}
+
+function enqueue(full: string, text: string): Promise<void> {
+  const q = queues.get(full);
+  if (q) {
+    return new Promise<void>((resolve, reject) => {
+      const waiters = q.next?.waiters ?? [];
+      waiters.push({ resolve, reject });
+      q.next = { text, waiters };
+    });
+  }
+  const entry: FileQueue = { running: Promise.resolve() };
+  queues.set(full, entry);
+  const run = async (t: string): Promise<void> => {
+    try {
+      await writeAtomic(full, t);
+    } finally {
+      const next = entry.next;
+      entry.next = undefined;
+      if (next) {
+        entry.running = run(next.text).then(
+          () => next.waiters.forEach((w) => w.resolve()),
+          (e: unknown) => next.waiters.forEach((w) => w.reject(e)),
+        );
+      } else {
+        queues.delete(full);
+      }
+    }
+  };
+  entry.running = run(text);
+  return entry.running;
+}
+
+/** Resolves when every write started so far (and the ones they queued) has finished. */
+export async function flushWrites(): Promise<void> {
+  while (queues.size > 0) {
+    await Promise.allSettled([...queues.values()].map((q) => q.running));
+  }
+}
 
 /** File access for blocks: relative paths are resolved against the pipeline file's folder. */
 export function nodeResources(baseDir: string): Resources {
@@ -21,8 +85,7 @@ export function nodeResources(baseDir: string): Resources {
     writeText: async (p: string, text: string) => {
       const full = isAbsolute(p) ? p : resolve(baseDir, p);
       try {
-        await mkdir(dirname(full), { recursive: true });
-        await writeFile(full, text, "utf8");
+        await enqueue(full, text);
       } catch (e) {
         const code = (e as NodeJS.ErrnoException).code;
         if (code === "EACCES") throw new Error(`no permission to write ${full}`);
