@@ -2,13 +2,15 @@
  * `mosaic`: run and check pipelines headless.
  *
  *   mosaic validate FILE...            exit 0 when valid, 2 with file:line:col messages otherwise
+ *   mosaic format FILE... [--check]    canonical round trip through the editor's document model
  *   mosaic run FILE [options]          live per-block table (or --json lines); Ctrl-C stops cleanly
  *   mosaic bench [options]             the standard performance suite (see `mosaic bench --help`)
  */
-import { readFileSync } from "node:fs";
+import { readFileSync, writeFileSync } from "node:fs";
 import { dirname, join, resolve } from "node:path";
 import { parseArgs } from "node:util";
 import { formatDiagnostic } from "../engine/diagnostics";
+import { PipelineDocument } from "../engine/pipeline/document";
 import type { Telemetry } from "../engine/runtime/runtime";
 import { Host, webRoot } from "../host/host";
 import { serveStatic } from "../host/web-server";
@@ -23,6 +25,12 @@ Usage:
   mosaic validate FILE...
       Checks pipeline files (YAML syntax, block types, params, wiring, shapes, files they read).
       Exit 0 when every file is valid, 2 otherwise; messages are file:line:col.
+  mosaic format FILE... [--check]
+      Loads each pipeline through the editor's document model (the code the visual editor saves
+      with) and writes it back in canonical form: a no-op on a valid file except that a missing
+      final line break is added (comments, key order and styles are kept). An invalid file is
+      never written: its messages are printed (file:line:col) and the exit code is 2. --check
+      writes nothing and lists the files that would change (exit 1).
   mosaic run FILE [--duration S] [--clock realtime|virtual] [--json] [--precision]
                   [--log-dir DIR] [--start T] [--warmup S]
       Runs a pipeline and shows a live per-block table: desired and actual rate, status
@@ -78,6 +86,73 @@ async function cmdValidate(files: string[]): Promise<number> {
     }
   }
   return bad ? 2 : 0;
+}
+
+async function cmdFormat(args: string[]): Promise<number> {
+  let values: { check: boolean };
+  let files: string[];
+  try {
+    const r = parseArgs({
+      args,
+      allowPositionals: true,
+      options: { check: { type: "boolean", default: false } },
+    });
+    values = { check: r.values.check };
+    files = r.positionals;
+  } catch (e) {
+    err(`mosaic format: ${(e as Error).message}`);
+    return 2;
+  }
+  if (files.length === 0) {
+    err("usage: mosaic format FILE... [--check]");
+    return 2;
+  }
+  // The same full check as `mosaic validate` (loader, then every block instantiated).
+  const { loadDspFromDisk, validatePipelineFile } = await import("../host/validate");
+  loadDspFromDisk();
+  let invalid = false;
+  let changed = 0;
+  for (const f of files) {
+    const ds = await validatePipelineFile(f);
+    const errors = ds.filter((d) => d.severity === "error");
+    if (errors.length > 0) {
+      for (const d of errors) err(formatDiagnostic(d));
+      err(`${f}: invalid (${errors.length} error${errors.length === 1 ? "" : "s"}), not formatted`);
+      invalid = true;
+      continue;
+    }
+    let source: string;
+    let formatted: string;
+    try {
+      source = readFileSync(f, "utf8");
+      const doc = PipelineDocument.parse(source, f);
+      doc.normalize();
+      formatted = doc.toString();
+    } catch (e) {
+      err(`${f}: ${(e as Error).message}`);
+      invalid = true;
+      continue;
+    }
+    if (formatted === source) {
+      out(`${f}: unchanged`);
+      continue;
+    }
+    changed++;
+    if (values.check) {
+      out(`${f}: would change`);
+      continue;
+    }
+    try {
+      writeFileSync(f, formatted);
+    } catch (e) {
+      err(`${f}: cannot write: ${(e as Error).message}`);
+      invalid = true;
+      continue;
+    }
+    out(`${f}: formatted`);
+  }
+  if (invalid) return 2;
+  return values.check && changed > 0 ? 1 : 0;
 }
 
 function summaryLines(t: Telemetry): string[] {
@@ -384,6 +459,8 @@ export async function main(argv: string[]): Promise<number> {
       return 0;
     case "validate":
       return cmdValidate(rest);
+    case "format":
+      return cmdFormat(rest);
     case "run":
       return cmdRun(rest);
     case "bench":
@@ -394,7 +471,7 @@ export async function main(argv: string[]): Promise<number> {
       return cmdServe(rest);
     default:
       err(
-        `mosaic: unknown command '${cmd}' (commands: validate, run, web, serve, bench; see mosaic --help)`,
+        `mosaic: unknown command '${cmd}' (commands: validate, format, run, web, serve, bench; see mosaic --help)`,
       );
       return 2;
   }

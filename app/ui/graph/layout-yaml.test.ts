@@ -150,7 +150,7 @@ describe("setBlockParam (a param edited in the form, written into the file)", ()
       "Emg:\n  Type: EmgSimulator\n  Params:\n    Sequence:\n      - { Gesture: rest, Seconds: 2 }\n    Seed: 7 # s\n";
     const out = setBlockParam(src, "Emg", "Sequence", [{ Gesture: "fist", Seconds: 1 }]);
     expect(out).toBe(
-      "Emg:\n  Type: EmgSimulator\n  Params:\n    Sequence:\n      [ { Gesture: fist, Seconds: 1 } ]\n    Seed: 7 # s\n",
+      "Emg:\n  Type: EmgSimulator\n  Params:\n    Sequence:\n      [{ Gesture: fist, Seconds: 1 }]\n    Seed: 7 # s\n",
     );
     expect(parseDocument(out).toJS()).toEqual({
       Emg: {
