@@ -26,6 +26,8 @@ export const uiMessageSchema = z.discriminatedUnion("type", [
     source: z.string().max(4_000_000),
   }),
   z.strictObject({ type: z.literal("start"), id }),
+  /** Every block type the engine knows, with its metadata (the editor's palette and forms). */
+  z.strictObject({ type: z.literal("catalog"), id }),
   z.strictObject({ type: z.literal("stop"), id }),
   /** A live param (validated against the block's schema by the engine). */
   z.strictObject({
@@ -112,6 +114,33 @@ export interface BlockInfo {
   path?: string;
 }
 
+/** One block type of the engine's catalog (reply to `catalog`). */
+export interface BlockTypeInfo {
+  type: string;
+  /** Other names files may use (MOSAIC's class names). */
+  aliases: string[];
+  category: string;
+  summary: string;
+  help: string;
+  /** JSON Schema (draft 2020-12, input side) of the params. */
+  paramsSchema: unknown;
+  /** Fewest and most inputs (`max` null: any number), and the names of the positions. */
+  inputs: { min: number; max: number | null; labels: string[] };
+  /** Output port names with the default params (the first is the default port). */
+  outputs: string[];
+  /** A timer: its ticks carry no values and it needs `DesiredRate`. */
+  timer: boolean;
+  /** `DesiredRate` must be written in the file. */
+  requiresRate: boolean;
+  /** Params that can be changed while running. */
+  live: string[];
+  views: string[];
+}
+
+export interface CatalogInfo {
+  types: BlockTypeInfo[];
+}
+
 export interface GraphInfo {
   file: string;
   blocks: BlockInfo[];
@@ -142,6 +171,7 @@ export type EngineMessage =
       message?: string;
       diagnostics?: Diagnostic[];
       graph?: GraphInfo;
+      catalog?: CatalogInfo;
     }
   | { type: "state"; state: EngineState; file?: string }
   /**

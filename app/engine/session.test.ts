@@ -147,4 +147,35 @@ describe("EngineSession", () => {
     await s.handle(null);
     expect(replies(f.sent).at(-1)).toMatchObject({ id: -1, ok: false });
   });
+
+  test("catalog: every type once (no aliases) with its metadata, the params schema and the ports", async () => {
+    const f = fakePlatform();
+    const s = new EngineSession(testCatalog, f.platform);
+    await s.handle({ type: "catalog", id: 1 });
+    const r = replies(f.sent)[0]!;
+    expect(r).toMatchObject({ type: "reply", id: 1, ok: true });
+    const types = (r as Extract<EngineMessage, { type: "reply" }>).catalog!.types;
+    const names = types.map((t) => t.type);
+    expect(new Set(names).size).toBe(names.length);
+    const tick = types.find((t) => t.type === "Tick")!;
+    expect(tick).toMatchObject({
+      category: "Testing",
+      summary: "test timer",
+      timer: true,
+      requiresRate: true,
+      inputs: { min: 0, max: 0 },
+    });
+    const counter = types.find((t) => t.type === "Counter")!;
+    expect(Object.keys((counter.paramsSchema as { properties: object }).properties)).toEqual([
+      "Channels",
+      "Scale",
+    ]);
+    expect(counter.live).toEqual(["Scale"]);
+    expect(counter.outputs).toEqual(["out"]);
+    // Any number of inputs: null (JSON has no Infinity).
+    expect(types.find((t) => t.type === "Drain")!.inputs.max).toBeNull();
+    // Works without a pipeline, and again (cached).
+    await s.handle({ type: "catalog", id: 2 });
+    expect(replies(f.sent)[1]).toMatchObject({ id: 2, ok: true });
+  });
 });

@@ -4,7 +4,8 @@
  * Electron later — with the platform's clock, files, logs and real-time loop injected.
  */
 import { z } from "zod";
-import type { Catalog } from "./catalog";
+import { outputNames } from "./block";
+import { catalogTypes, type Catalog } from "./catalog";
 import type { Clock } from "./clock";
 import { errorMessage, type Diagnostic } from "./diagnostics";
 import type { Frame } from "./frame";
@@ -13,6 +14,7 @@ import {
   PROTOCOL_VERSION,
   parseUiMessage,
   type BlockInfo,
+  type CatalogInfo,
   type EngineMessage,
   type EngineState,
   type GraphInfo,
@@ -201,6 +203,9 @@ export class EngineSession {
         });
         return;
       }
+      case "catalog":
+        this.reply(msg.id, true, undefined, { catalog: this.catalogInfo() });
+        return;
       case "start":
         this.start();
         this.reply(msg.id, true);
@@ -292,6 +297,48 @@ export class EngineSession {
     this.spec = loaded.spec;
     this.setState("loaded");
     return { diagnostics, graph: this.graph() };
+  }
+
+  /** The catalog's metadata for the editor (built once: the catalog never changes). */
+  private catalogCache: CatalogInfo | undefined;
+  private catalogInfo(): CatalogInfo {
+    if (this.catalogCache) return this.catalogCache;
+    const types = catalogTypes(this.catalog).map((d) => {
+      let schema: unknown = {};
+      try {
+        schema = z.toJSONSchema(d.params, { io: "input", unrepresentable: "any" });
+      } catch {
+        schema = {};
+      }
+      let outputs: string[] = ["out"];
+      try {
+        const defaults = d.params.safeParse({});
+        outputs = [...outputNames(d, defaults.success ? defaults.data : {})];
+      } catch {
+        /* ports that need params: the default port */
+      }
+      return {
+        type: d.type,
+        aliases: [...(d.aliases ?? [])],
+        category: d.category,
+        summary: d.summary,
+        help: d.help,
+        paramsSchema: schema,
+        inputs: {
+          min: d.inputs.min,
+          max: Number.isFinite(d.inputs.max) ? d.inputs.max : null,
+          labels: [...(d.inputs.labels ?? [])],
+        },
+        outputs,
+        timer: d.timer === true,
+        requiresRate: d.requiresRate === true || d.timer === true,
+        live: [...(d.live ?? [])],
+        views: [...(d.views ?? [])],
+      };
+    });
+    types.sort((a, b) => a.category.localeCompare(b.category) || a.type.localeCompare(b.type));
+    this.catalogCache = { types };
+    return this.catalogCache;
   }
 
   private graph(): GraphInfo {

@@ -10,6 +10,7 @@ import type { EngineClient } from "../client/engine-client";
 import { EngineContext, useEngine, useEngineInfo, useEngineState } from "../client/hooks";
 import { BlockTable } from "../graph/block-table";
 import { StimulusOverlay } from "../stimulus/stimulus-view";
+import { Editor, EMPTY_FILE } from "../editor/editor";
 import { Diagnostics } from "./diagnostics";
 import { EventLog, type LogEntry } from "./event-log";
 import { GestureLegend, useGestureKeys } from "./gestures";
@@ -309,6 +310,42 @@ function Shell({
   const stimulusBlock = stimulus !== null ? blocks.get(stimulus) : undefined;
   const [warningsHidden, setWarningsHidden] = useState(-1);
 
+  // ---- edit mode (issue 8): the editor holds its own text; Apply loads it and starts it.
+  const [editing, setEditing] = useState(false);
+  const [applying, setApplying] = useState(false);
+  const draft = useRef<{ file: string; text: string } | null>(null);
+  const onDraft = useCallback((file: string, text: string) => {
+    draft.current = { file, text };
+  }, []);
+  const applyEdit = useCallback(async (file: string, text: string) => {
+    setApplying(true);
+    try {
+      return await current.current.loadSource(file, text, true);
+    } finally {
+      setApplying(false);
+    }
+  }, []);
+  const editFile = draft.current?.file ?? pipeline.file ?? EMPTY_FILE;
+  const editText =
+    draft.current?.text ?? (pipeline.file !== undefined ? (pipeline.source ?? "") : "");
+  // A draft is kept while leaving edit mode (said so), and dropped when another load happens.
+  useEffect(() => {
+    if (!editingRef.current) draft.current = null;
+  }, [generation]);
+  const editingRef = useRef(editing);
+  editingRef.current = editing;
+  const leaveEdit = (): void => {
+    setEditing(false);
+    const d = draft.current;
+    if (d && (d.text !== (pipeline.source ?? "") || d.file !== pipeline.file))
+      notify("Edits not applied are kept: press Edit to go on with them");
+    else draft.current = null;
+  };
+  const editorNotify = useCallback(
+    (m: string, level?: "info" | "error") => notify(m, level),
+    [notify],
+  );
+
   return (
     <UiContext.Provider value={ui}>
       <div
@@ -361,7 +398,7 @@ function Shell({
             aria-label={`Engine ${STATE_LABEL[state]}`}
           >
             <span className="engine-state__dot" aria-hidden="true" />
-            {pipeline.loading ? "loading…" : STATE_LABEL[state]}
+            {applying ? "restarting…" : pipeline.loading ? "loading…" : STATE_LABEL[state]}
           </span>
           {stimuli.length > 0 ? (
             <button
@@ -372,6 +409,15 @@ function Shell({
               Stimulus
             </button>
           ) : null}
+          <button
+            type="button"
+            aria-pressed={editing}
+            onClick={() => (editing ? leaveEdit() : setEditing(true))}
+            disabled={pipeline.loading && !editing}
+            title="Edit the pipeline: palette, canvas, inspector and YAML side by side"
+          >
+            Edit
+          </button>
           <span className="toolbar__spacer" />
           <span
             className={`timing ${info.sharedMemory ? "is-precise" : "is-coarse"}`}
@@ -387,7 +433,24 @@ function Shell({
         </header>
 
         <main className="main">
-          {graph !== undefined &&
+          {editing ? (
+            <Editor
+              client={client}
+              initialText={editText}
+              initialFile={editFile}
+              appliedText={pipeline.source}
+              templates={pipeline.index}
+              graph={graph}
+              running={running}
+              applying={applying}
+              onApply={applyEdit}
+              onNotify={editorNotify}
+              onDraft={onDraft}
+              onClose={leaveEdit}
+            />
+          ) : null}
+          {!editing &&
+          graph !== undefined &&
           pipeline.diagnostics.length > 0 &&
           warningsHidden !== generation ? (
             <div className="warnings-banner">
@@ -401,7 +464,7 @@ function Shell({
               </button>
             </div>
           ) : null}
-          {graph !== undefined ? (
+          {editing ? null : graph !== undefined ? (
             <PanelHost
               panels={panels}
               blocks={blocks}

@@ -4,6 +4,7 @@
  * Framework-free; React components use it through the hooks in ./hooks.ts.
  */
 import type {
+  CatalogInfo,
   DataMessage,
   EngineConnection,
   EngineMessage,
@@ -25,6 +26,7 @@ export interface Reply {
   message?: string;
   diagnostics?: Diagnostic[];
   graph?: GraphInfo;
+  catalog?: CatalogInfo;
 }
 
 export type DataListener = (m: DataMessage) => void;
@@ -104,6 +106,17 @@ export class EngineClient {
     this.graph = r.graph;
     for (const l of this.graphListeners) l(this.graph);
     return r;
+  }
+
+  private catalogPromise: Promise<CatalogInfo | undefined> | undefined;
+
+  /** Every block type the engine knows, with its metadata (asked once, then cached). */
+  catalog(): Promise<CatalogInfo | undefined> {
+    this.catalogPromise ??= this.request({ type: "catalog" }).then((r) => {
+      if (!r.ok) this.catalogPromise = undefined;
+      return r.catalog;
+    });
+    return this.catalogPromise;
   }
 
   start(): Promise<Reply> {

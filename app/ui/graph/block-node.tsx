@@ -20,6 +20,8 @@ import {
 
 export interface BlockNodeData extends Record<string, unknown> {
   block: BlockInfo;
+  /** Edit mode (app/ui/editor): handles connect, the block's problems show on the node. */
+  edit?: { issues: string[] };
 }
 export type BlockNodeType = Node<BlockNodeData, "block">;
 
@@ -88,6 +90,7 @@ const HOLD = {
 
 function BlockNodeComponent({ data }: NodeProps<BlockNodeType>) {
   const b = data.block;
+  const edit = data.edit;
   const g = useContext(GraphStateContext);
   const v = useTelemetrySelector((t) => blockView(t, b.name, g.running), undefined, HOLD);
   const both = v.status === "lagging" && v.stumbling;
@@ -111,34 +114,40 @@ function BlockNodeComponent({ data }: NodeProps<BlockNodeType>) {
         `block-node status-${v.status}` +
         (both ? " also-stumbling" : "") +
         (open ? " panel-open" : "") +
-        (v.errors > 0 ? " has-errors" : "")
+        (v.errors > 0 ? " has-errors" : "") +
+        (edit ? " is-editing" : "") +
+        (edit && edit.issues.length > 0 ? " has-issues" : "")
       }
       data-block={b.name}
       data-status={v.status}
       data-stumbling={String(v.stumbling)}
-      title={title}
+      data-issues={edit ? String(edit.issues.length) : undefined}
+      title={edit ? `${b.name} (${b.type})${b.summary ? `\n${b.summary}` : ""}` : title}
     >
       <Handle
         type="target"
         position={Position.Left}
-        isConnectable={false}
-        className={b.inputs.length === 0 ? "handle-unused" : ""}
+        isConnectable={edit !== undefined}
+        aria-label={edit ? `inputs of ${b.name}` : undefined}
+        className={b.inputs.length === 0 && !edit ? "handle-unused" : ""}
       />
       <div className="block-node__head">
         <span className="block-node__name">{b.name}</span>
-        <button
-          type="button"
-          className="block-node__menu nodrag"
-          tabIndex={-1}
-          aria-label={`Actions of ${b.name}`}
-          onClick={(e) => {
-            e.stopPropagation();
-            const r = e.currentTarget.getBoundingClientRect();
-            g.onMenu(b.name, { x: r.left, y: r.bottom + 2 });
-          }}
-        >
-          ⋮
-        </button>
+        {edit ? null : (
+          <button
+            type="button"
+            className="block-node__menu nodrag"
+            tabIndex={-1}
+            aria-label={`Actions of ${b.name}`}
+            onClick={(e) => {
+              e.stopPropagation();
+              const r = e.currentTarget.getBoundingClientRect();
+              g.onMenu(b.name, { x: r.left, y: r.bottom + 2 });
+            }}
+          >
+            ⋮
+          </button>
+        )}
       </div>
       <div className="block-node__type">{b.type}</div>
       <div className="block-node__status" aria-label={`status: ${label}`}>
@@ -167,7 +176,19 @@ function BlockNodeComponent({ data }: NodeProps<BlockNodeType>) {
           <span className="block-node__note">{v.errors > 0 ? v.lastError : v.text}</span>
         </div>
       ) : null}
-      <Handle type="source" position={Position.Right} isConnectable={false} />
+      {edit && edit.issues.length > 0 ? (
+        <ul className="block-node__issues">
+          {edit.issues.map((m, i) => (
+            <li key={i}>{m}</li>
+          ))}
+        </ul>
+      ) : null}
+      <Handle
+        type="source"
+        position={Position.Right}
+        isConnectable={edit !== undefined}
+        aria-label={edit ? `output of ${b.name}` : undefined}
+      />
     </div>
   );
 }

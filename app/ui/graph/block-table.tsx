@@ -108,7 +108,8 @@ function buildEdges(graph: GraphInfo): RateEdgeType[] {
   );
 }
 
-function download(name: string, text: string): void {
+/** Downloads `text` as a file named `name` (the browser cannot write files). */
+export function download(name: string, text: string): void {
   const url = URL.createObjectURL(new Blob([text], { type: "text/yaml" }));
   const a = document.createElement("a");
   a.href = url;

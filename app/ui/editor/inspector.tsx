@@ -1,0 +1,177 @@
+/**
+ * The inspector of the selected block in edit mode: name (rename: references follow), type with
+ * its help, DesiredRate, Path, Inputs and the params form generated from the type's schema. Every
+ * change goes to the document; a live param of a block that runs is also applied at once.
+ */
+import { useEffect, useId, useState, type ReactNode } from "react";
+import type { BlockInfo, BlockTypeInfo } from "../../engine/protocol";
+import { ParamsForm, type SetResult } from "../forms/params-form";
+import type { EditBlock, EditIssue } from "./model";
+
+export interface InspectorProps {
+  block: EditBlock;
+  type: BlockTypeInfo | undefined;
+  issues: readonly EditIssue[];
+  /** The block's info in the running pipeline (same name and type), when it runs. */
+  runningBlock: BlockInfo | undefined;
+  onRename(to: string): string | undefined;
+  onDesiredRate(rate: number | undefined): string | undefined;
+  onPath(path: string | undefined): string | undefined;
+  onInputs(inputs: string[]): string | undefined;
+  onParam(param: string, value: unknown): Promise<SetResult>;
+}
+
+/** A text field committed with Enter or on leaving it; Escape restores the value. */
+function CommitField({
+  label,
+  value,
+  placeholder,
+  hint,
+  inputMode,
+  onCommit,
+}: {
+  label: string;
+  value: string;
+  placeholder?: string;
+  hint?: string;
+  inputMode?: "decimal" | "text";
+  onCommit(text: string): string | undefined;
+}): ReactNode {
+  const id = useId();
+  const [draft, setDraft] = useState(value);
+  const [error, setError] = useState<string | undefined>();
+  useEffect(() => {
+    setDraft(value);
+    setError(undefined);
+  }, [value]);
+  const commit = (): void => {
+    if (draft === value) return;
+    const e = onCommit(draft.trim());
+    setError(e);
+  };
+  return (
+    <div className="inspector__field">
+      <label htmlFor={id}>{label}</label>
+      <input
+        id={id}
+        type="text"
+        value={draft}
+        placeholder={placeholder}
+        inputMode={inputMode}
+        aria-invalid={error !== undefined}
+        aria-describedby={`${id}-hint`}
+        onChange={(e) => setDraft(e.target.value)}
+        onBlur={commit}
+        onKeyDown={(e) => {
+          if (e.key === "Enter") {
+            e.preventDefault();
+            commit();
+          } else if (e.key === "Escape") {
+            setDraft(value);
+            setError(undefined);
+          }
+        }}
+      />
+      <span id={`${id}-hint`} className={error ? "inspector__error" : "inspector__hint"}>
+        {error ?? hint ?? ""}
+      </span>
+    </div>
+  );
+}
+
+export function Inspector(props: InspectorProps): ReactNode {
+  const { block: b, type: t, issues } = props;
+  const info: BlockInfo = {
+    name: b.name,
+    type: t?.type ?? b.type,
+    category: t?.category ?? "",
+    summary: t?.summary ?? "",
+    help: t?.help ?? "",
+    worker: "main",
+    timer: t?.timer ?? false,
+    desiredRate: b.desiredRate ?? 0,
+    inputs: b.inputs.map((i) => ({ ...i })),
+    outputs: [],
+    views: [],
+    panel: "",
+    live: t?.live ?? [],
+    params: b.params,
+    paramsSchema: t?.paramsSchema ?? {},
+    actions: [],
+  };
+  const inputsText = b.inputs.map((i) => `${i.subscribed ? "" : "-"}${i.source}`).join(", ");
+  const mine = issues.filter((i) => i.block === b.name);
+  return (
+    <section className="inspector" aria-label={`Inspector: ${b.name}`} data-inspector={b.name}>
+      <h3 className="inspector__title">
+        {b.name} <span className="inspector__type">{info.type || "(no type)"}</span>
+      </h3>
+      {t ? (
+        <details className="inspector__help">
+          <summary>{t.summary}</summary>
+          <p>{t.help}</p>
+        </details>
+      ) : null}
+      {mine.length > 0 ? (
+        <ul className="inspector__issues" aria-label="Problems">
+          {mine.map((i, k) => (
+            <li key={k}>{i.message}</li>
+          ))}
+        </ul>
+      ) : null}
+      <CommitField
+        label="Name"
+        value={b.name}
+        hint="Enter to rename (inputs that name it follow)"
+        onCommit={(s) => props.onRename(s)}
+      />
+      <CommitField
+        label="DesiredRate (Hz)"
+        value={b.desiredRate !== undefined ? String(b.desiredRate) : ""}
+        inputMode="decimal"
+        placeholder={t?.requiresRate ? "required" : "inherited from the inputs"}
+        onCommit={(s) => {
+          if (s === "") return props.onDesiredRate(undefined);
+          const n = Number(s);
+          if (!Number.isFinite(n) || n <= 0) return "a positive number of Hz";
+          return props.onDesiredRate(n);
+        }}
+      />
+      <CommitField
+        label="Inputs"
+        value={inputsText}
+        placeholder={t && t.inputs.min === 0 && t.inputs.max === 0 ? "none" : "e.g. Timer, Emg"}
+        hint={
+          t
+            ? `${t.inputs.min}${t.inputs.max === null ? "+" : t.inputs.max === t.inputs.min ? "" : `–${t.inputs.max}`} input(s), comma-separated; Block.port for another output, -Block: not subscribed`
+            : undefined
+        }
+        onCommit={(s) =>
+          props.onInputs(
+            s
+              .split(/[,\s]+/)
+              .map((x) => x.trim())
+              .filter((x) => x !== ""),
+          )
+        }
+      />
+      <CommitField
+        label="Path (log)"
+        value={b.path ?? ""}
+        placeholder="not logged"
+        onCommit={(s) => props.onPath(s === "" ? undefined : s)}
+      />
+      <h4 className="inspector__params-title">Params</h4>
+      {t ? (
+        <ParamsForm
+          block={info}
+          engineState="loaded"
+          onSet={(param, value) => props.onParam(param, value)}
+          onEditStatic={(param, value) => props.onParam(param, value)}
+        />
+      ) : (
+        <p className="inspector__hint">Unknown type: no params form.</p>
+      )}
+    </section>
+  );
+}

@@ -1,0 +1,204 @@
+/**
+ * What the editor shows of a pipeline's text: the blocks as written (type, inputs, params,
+ * DesiredRate, Path, Layout) and the problems that can be found without the engine — YAML
+ * errors, unknown types, bad names, dangling inputs (a block or port that does not exist), the
+ * number of inputs, a timer without DesiredRate, params that do not match the type's schema.
+ * The engine's loader has the last word when the pipeline is applied; these checks only keep
+ * invalid edits from being saved or applied.
+ */
+import { LineCounter, parseDocument, isMap, isScalar, type Pair } from "yaml";
+import type { BlockTypeInfo, CatalogInfo } from "../../engine/protocol";
+import { validate as validateValue, formatPath, type JsonSchema } from "../forms/schema";
+
+export interface EditInput {
+  /** As written, without the leading '-': "Block" or "Block.port". */
+  source: string;
+  block: string;
+  port: string;
+  subscribed: boolean;
+}
+
+export interface EditBlock {
+  name: string;
+  type: string;
+  inputs: EditInput[];
+  params: Record<string, unknown>;
+  desiredRate?: number;
+  path?: string;
+  layout?: { x: number; y: number };
+  /** 1-based line of the block's key (0: unknown). */
+  line: number;
+}
+
+export interface EditIssue {
+  severity: "error" | "warning";
+  message: string;
+  block?: string;
+  /** What the issue is about: "Type", "Inputs", "DesiredRate", "Params.<name>". */
+  field?: string;
+  /** 1-based; 0 when unknown. */
+  line: number;
+  col: number;
+}
+
+export interface ReadResult {
+  blocks: EditBlock[];
+  /** YAML syntax errors: the text does not parse (the canvas keeps the last good blocks). */
+  errors: EditIssue[];
+}
+
+export const BLOCK_NAME = /^[A-Za-z_][A-Za-z0-9_-]*$/;
+
+function keyOf(pair: Pair): unknown {
+  return isScalar(pair.key) ? pair.key.value : pair.key;
+}
+
+function parseInput(s: string): EditInput {
+  const subscribed = !s.startsWith("-");
+  const source = subscribed ? s : s.slice(1);
+  const dot = source.indexOf(".");
+  return {
+    source,
+    block: dot < 0 ? source : source.slice(0, dot),
+    port: dot < 0 ? "" : source.slice(dot + 1),
+    subscribed,
+  };
+}
+
+const isRecord = (v: unknown): v is Record<string, unknown> =>
+  v !== null && typeof v === "object" && !Array.isArray(v);
+
+/** The blocks of a pipeline's text, in file order. */
+export function readBlocks(text: string): ReadResult {
+  const lc = new LineCounter();
+  const doc = parseDocument(text, { lineCounter: lc, prettyErrors: false });
+  const errors: EditIssue[] = doc.errors.map((e) => {
+    const p = lc.linePos(e.pos[0]);
+    return {
+      severity: "error",
+      message: e.message.split("\n")[0]!,
+      line: p.line,
+      col: p.col,
+    };
+  });
+  if (errors.length > 0) return { blocks: [], errors };
+  const root = doc.contents;
+  if (root === null || (isScalar(root) && root.value === null)) return { blocks: [], errors };
+  if (!isMap(root)) {
+    return {
+      blocks: [],
+      errors: [
+        {
+          severity: "error",
+          message: "the pipeline is not a mapping of blocks (Name: { Type: …, Inputs: [...] })",
+          line: 1,
+          col: 1,
+        },
+      ],
+    };
+  }
+  const blocks: EditBlock[] = [];
+  for (const pair of root.items) {
+    const name = keyOf(pair);
+    if (typeof name !== "string") continue;
+    const start = (pair.key as { range?: [number, number, number] } | null)?.range?.[0];
+    const line = start !== undefined ? lc.linePos(start).line : 0;
+    const v = (pair.value as { toJSON?(): unknown } | null)?.toJSON?.() ?? null;
+    const o = isRecord(v) ? v : {};
+    const rawInputs = o.Inputs;
+    const list = Array.isArray(rawInputs)
+      ? rawInputs
+      : rawInputs === undefined || rawInputs === null
+        ? []
+        : [rawInputs];
+    const layout = isRecord(o.Layout) ? o.Layout : undefined;
+    blocks.push({
+      name,
+      type: typeof o.Type === "string" ? o.Type : "",
+      inputs: list.map((x) => parseInput(String(x))),
+      params: isRecord(o.Params) ? o.Params : {},
+      ...(typeof o.DesiredRate === "number" ? { desiredRate: o.DesiredRate } : {}),
+      ...(typeof o.Path === "string" ? { path: o.Path } : {}),
+      ...(layout && typeof layout.X === "number" && typeof layout.Y === "number"
+        ? { layout: { x: layout.X, y: layout.Y } }
+        : {}),
+      line,
+    });
+  }
+  return { blocks, errors };
+}
+
+/** The catalog by type name, aliases included. */
+export function typeIndex(catalog: CatalogInfo | undefined): Map<string, BlockTypeInfo> {
+  const m = new Map<string, BlockTypeInfo>();
+  for (const t of catalog?.types ?? []) {
+    m.set(t.type, t);
+    for (const a of t.aliases) m.set(a, t);
+  }
+  return m;
+}
+
+/** Problems the editor can see without the engine (see the file's comment). */
+export function checkBlocks(
+  blocks: readonly EditBlock[],
+  catalog: CatalogInfo | undefined,
+): EditIssue[] {
+  const types = typeIndex(catalog);
+  const byName = new Map(blocks.map((b) => [b.name, b]));
+  const issues: EditIssue[] = [];
+  for (const b of blocks) {
+    const at = { block: b.name, line: b.line, col: 1 };
+    const err = (message: string, field?: string): void => {
+      issues.push({ severity: "error", message, ...at, ...(field ? { field } : {}) });
+    };
+    if (!BLOCK_NAME.test(b.name))
+      err(`'${b.name}' is not a valid block name (letters, digits, '_' or '-')`);
+    if (b.type === "") {
+      err(`block '${b.name}' has no Type`, "Type");
+      continue;
+    }
+    const t = types.get(b.type);
+    if (catalog && !t) {
+      err(`block '${b.name}': unknown type '${b.type}'`, "Type");
+      continue;
+    }
+    b.inputs.forEach((inp, i) => {
+      const src = byName.get(inp.block);
+      if (!src) {
+        err(`block '${b.name}': input ${i + 1} '${inp.source}' is not a block`, "Inputs");
+        return;
+      }
+      if (inp.port !== "") {
+        const st = types.get(src.type);
+        if (st && st.outputs.length > 0 && !st.outputs.includes(inp.port))
+          err(
+            `block '${b.name}': '${inp.block}' has no output '${inp.port}' (${st.outputs.join(", ")})`,
+            "Inputs",
+          );
+      }
+    });
+    if (!t) continue;
+    const n = b.inputs.length;
+    const { min, max } = t.inputs;
+    if (n < min || (max !== null && n > max)) {
+      const want = max === null ? `at least ${min}` : min === max ? `${min}` : `${min} to ${max}`;
+      err(
+        `block '${b.name}' (${t.type}) takes ${want} input${want === "1" ? "" : "s"}, not ${n}`,
+        "Inputs",
+      );
+    }
+    if (t.requiresRate && b.desiredRate === undefined)
+      err(`block '${b.name}' (${t.type}) needs a DesiredRate`, "DesiredRate");
+    if (b.desiredRate !== undefined && !(b.desiredRate > 0))
+      err(`block '${b.name}': DesiredRate must be a positive number of Hz`, "DesiredRate");
+    const schema = t.paramsSchema as JsonSchema;
+    for (const issue of validateValue(schema, b.params)) {
+      const where = formatPath(issue.path);
+      err(
+        `block '${b.name}': ${where ? `${where}: ` : "Params: "}${issue.message}`,
+        where ? `Params.${String(issue.path[0])}` : "Params",
+      );
+    }
+  }
+  return issues;
+}

@@ -1,0 +1,159 @@
+/**
+ * The pipeline's YAML beside the canvas (CodeMirror 6): syntax highlighting, completion of block
+ * types, block keys, param names (from the engine's catalog) and input names, and the problems
+ * inline (the editor's checks, and the engine's after an Apply). Typing replaces the editor's
+ * text, so the canvas follows whenever it parses; canvas edits replace what it shows. Undo and
+ * redo are the editor's (one history for both sides). Problems are also listed under it;
+ * clicking one puts the cursor on its line.
+ */
+import {
+  autocompletion,
+  type CompletionContext,
+  type CompletionResult,
+} from "@codemirror/autocomplete";
+import { defaultKeymap, indentWithTab } from "@codemirror/commands";
+import { yaml } from "@codemirror/lang-yaml";
+import { defaultHighlightStyle, syntaxHighlighting } from "@codemirror/language";
+import {
+  forceLinting,
+  linter,
+  lintGutter,
+  type Diagnostic as LintDiagnostic,
+} from "@codemirror/lint";
+import { Annotation, EditorState } from "@codemirror/state";
+import {
+  EditorView,
+  highlightActiveLine,
+  highlightActiveLineGutter,
+  keymap,
+  lineNumbers,
+} from "@codemirror/view";
+import { useEffect, useRef, type ReactNode } from "react";
+import type { CatalogInfo } from "../../engine/protocol";
+import { completeAt } from "./completion";
+import type { EditIssue } from "./model";
+
+export interface TextViewProps {
+  text: string;
+  issues: readonly EditIssue[];
+  catalog: CatalogInfo | undefined;
+  onChange(text: string): void;
+}
+
+/** Marks the transactions that bring in a text from outside (not the user's typing). */
+const External = Annotation.define<boolean>();
+
+function lineOffset(state: EditorState, line: number, col: number): { from: number; to: number } {
+  const n = Math.max(1, Math.min(state.doc.lines, line || 1));
+  const l = state.doc.line(n);
+  const from = Math.min(l.to, l.from + Math.max(0, col - 1));
+  return { from, to: from < l.to ? l.to : from };
+}
+
+export function TextView({ text, issues, catalog, onChange }: TextViewProps): ReactNode {
+  const host = useRef<HTMLDivElement>(null);
+  const view = useRef<EditorView | null>(null);
+  const latest = useRef({ issues, catalog, onChange });
+  latest.current = { issues, catalog, onChange };
+
+  useEffect(() => {
+    const el = host.current;
+    if (!el) return undefined;
+    const v = new EditorView({
+      parent: el,
+      state: EditorState.create({
+        doc: text,
+        extensions: [
+          lineNumbers(),
+          highlightActiveLineGutter(),
+          highlightActiveLine(),
+          yaml(),
+          syntaxHighlighting(defaultHighlightStyle, { fallback: true }),
+          autocompletion({
+            override: [
+              (ctx: CompletionContext): CompletionResult | null =>
+                completeAt(ctx.state.doc.toString(), ctx.pos, latest.current.catalog),
+            ],
+          }),
+          linter(
+            (ev): LintDiagnostic[] =>
+              latest.current.issues
+                .filter((i) => i.line > 0)
+                .map((i) => {
+                  const { from, to } = lineOffset(ev.state, i.line, i.col);
+                  return { from, to, severity: i.severity, message: i.message };
+                }),
+            { delay: 150 },
+          ),
+          lintGutter(),
+          keymap.of([...defaultKeymap, indentWithTab]),
+          EditorView.contentAttributes.of({ "aria-label": "Pipeline YAML" }),
+          EditorView.updateListener.of((u) => {
+            if (!u.docChanged || u.transactions.some((t) => t.annotation(External))) return;
+            latest.current.onChange(u.state.doc.toString());
+          }),
+        ],
+      }),
+    });
+    view.current = v;
+    return () => {
+      v.destroy();
+      view.current = null;
+    };
+    // Created once (with the first text); later texts follow in the effect below.
+  }, []);
+
+  // A text from elsewhere (a canvas edit, undo, a template): replace what differs.
+  useEffect(() => {
+    const v = view.current;
+    if (!v) return;
+    const old = v.state.doc.toString();
+    if (old === text) return;
+    let start = 0;
+    while (start < old.length && start < text.length && old[start] === text[start]) start++;
+    let endOld = old.length;
+    let endNew = text.length;
+    while (endOld > start && endNew > start && old[endOld - 1] === text[endNew - 1]) {
+      endOld--;
+      endNew--;
+    }
+    v.dispatch({
+      changes: { from: start, to: endOld, insert: text.slice(start, endNew) },
+      annotations: External.of(true),
+    });
+  }, [text]);
+
+  useEffect(() => {
+    if (view.current) forceLinting(view.current);
+  }, [issues]);
+
+  const goTo = (line: number, col: number): void => {
+    const v = view.current;
+    if (!v || line < 1) return;
+    const { from } = lineOffset(v.state, line, col);
+    v.dispatch({ selection: { anchor: from }, scrollIntoView: true });
+    v.focus();
+  };
+
+  return (
+    <section className="text-view" aria-label="Pipeline text (YAML)">
+      <div className="text-view__code" ref={host} />
+      {issues.length > 0 ? (
+        <ul className="text-view__issues" aria-label="Problems in the text">
+          {issues.map((i, k) => (
+            <li key={k} className={`level-${i.severity}`}>
+              <button
+                type="button"
+                onClick={() => goTo(i.line, i.col)}
+                aria-label={i.line > 0 ? `Go to line ${i.line}` : "Position unknown"}
+              >
+                {i.line > 0 ? `${i.line}:${i.col}` : "–"}
+              </button>{" "}
+              {i.message}
+            </li>
+          ))}
+        </ul>
+      ) : null}
+    </section>
+  );
+}
