@@ -52,7 +52,7 @@ mod error;
 mod features;
 mod filter;
 mod function;
-mod rng;
+pub mod rng;
 mod synth;
 mod window;
 

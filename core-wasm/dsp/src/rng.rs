@@ -1,6 +1,8 @@
 //! Deterministic pseudo-random numbers: xoshiro256++ seeded by splitmix64
 //! (both by Blackman & Vigna, <https://prng.di.unimi.it/>), and Gaussian
-//! deviates by the Marsaglia polar method.
+//! deviates by the Marsaglia polar method. Same seed, same draws, on every
+//! platform (integer arithmetic, and `ln`/`sqrt` of the same doubles). Shared
+//! by the EMG synthesiser and mosaic-learn's random Fourier features.
 
 /// splitmix64: used only to expand a 64-bit seed into xoshiro state.
 #[derive(Debug, Clone)]
@@ -26,22 +28,34 @@ pub(crate) fn mix64(mut z: u64) -> u64 {
 
 /// xoshiro256++ with a cached second Gaussian deviate.
 #[derive(Debug, Clone)]
-pub(crate) struct Rng {
+pub struct Rng {
     s: [u64; 4],
     spare: Option<f64>,
 }
 
 impl Rng {
     /// Seeds the generator for one stream (`stream` = channel index) of `seed`.
-    pub(crate) fn new(seed: u64, stream: u64) -> Self {
-        let mut sm = SplitMix64::new(seed ^ mix64(stream.wrapping_add(1)));
+    pub fn new(seed: u64, stream: u64) -> Self {
+        Rng::from_seed(seed ^ mix64(stream.wrapping_add(1)))
+    }
+
+    /// Seeds the generator with four consecutive splitmix64 outputs of `seed`.
+    ///
+    /// ```
+    /// let mut a = mosaic_dsp::rng::Rng::from_seed(3);
+    /// let mut b = mosaic_dsp::rng::Rng::from_seed(3);
+    /// assert_eq!(a.next_u64(), b.next_u64());
+    /// ```
+    pub fn from_seed(seed: u64) -> Self {
+        let mut sm = SplitMix64::new(seed);
         let s = [sm.next_u64(), sm.next_u64(), sm.next_u64(), sm.next_u64()];
         // splitmix64 is a bijection of its counter, so four consecutive outputs
         // are never all zero (the one state xoshiro must avoid).
         Rng { s, spare: None }
     }
 
-    pub(crate) fn next_u64(&mut self) -> u64 {
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
         let s = &mut self.s;
         let result = s[0].wrapping_add(s[3]).rotate_left(23).wrapping_add(s[0]);
         let t = s[1] << 17;
@@ -55,13 +69,13 @@ impl Rng {
     }
 
     /// Uniform in [0, 1) with 53 random bits.
-    pub(crate) fn uniform(&mut self) -> f64 {
+    pub fn uniform(&mut self) -> f64 {
         (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
     }
 
     /// Standard normal deviate (Marsaglia polar method; the second deviate of
     /// each pair is kept for the next call).
-    pub(crate) fn gaussian(&mut self) -> f64 {
+    pub fn gaussian(&mut self) -> f64 {
         if let Some(z) = self.spare.take() {
             return z;
         }
@@ -100,6 +114,13 @@ mod tests {
         assert_eq!(r.next_u64(), 41_943_041);
         assert_eq!(r.next_u64(), 58_720_359);
         assert_eq!(r.next_u64(), 3_588_806_011_781_223);
+    }
+
+    #[test]
+    fn from_seed_takes_the_splitmix64_outputs_of_the_seed() {
+        let r = Rng::from_seed(0);
+        assert_eq!(r.s[0], 0xE220_A839_7B1D_CDAF);
+        assert_eq!(r.s[1], 0x6E78_9E6A_A1B9_65F4);
     }
 
     #[test]

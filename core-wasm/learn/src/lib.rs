@@ -52,7 +52,6 @@ mod linalg;
 mod model;
 mod rff;
 mod ridge;
-mod rng;
 mod state;
 
 pub use error::LearnError;

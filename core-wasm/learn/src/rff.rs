@@ -1,7 +1,7 @@
 use crate::ridge::{check_pairs, usable};
-use crate::rng::Rng;
 use crate::state::{Reader, Writer};
 use crate::{check_rows, LearnError, PredictingMachine, Ridge, RidgeParams};
+use mosaic_dsp::rng::Rng;
 
 /// Most values of Ω (features × inputs): 32 MiB.
 const MAX_OMEGA: usize = 1 << 22;
@@ -123,7 +123,7 @@ impl RandomFourierFeatures {
         let model = Ridge::new(rff.features, outputs, ridge).map_err(features_named)?;
         let d = inputs;
         let big_d = rff.features;
-        let mut rng = Rng::new(rff.seed);
+        let mut rng = Rng::from_seed(rff.seed);
         let sd = (2.0 * rff.gamma).sqrt();
         let omega = (0..big_d * d).map(|_| sd * rng.gaussian()).collect();
         let offset = (0..big_d)
