@@ -19,11 +19,14 @@ import {
   legacyMachine,
   listR2,
   loadModel,
+  loadModelFile,
   MODEL_HELP,
+  modelFileArg,
   modelParams,
   ModelFileError,
   optionsFromParams,
-  serializeModel,
+  saveModelFile,
+  type ModelFileHost,
 } from "./model-file";
 
 /** MOSAIC's batch learning machines (Learning.cs). */
@@ -310,8 +313,26 @@ export const BatchPredictor = defineBlock({
       out.emit(o);
     };
 
-    const fileArg = (arg: unknown): string =>
-      typeof arg === "string" && arg.trim() !== "" ? arg.trim() : defaultFile;
+    const files: ModelFileHost = {
+      ctx,
+      model: () => model,
+      expect: { inputs: d, outputs: M, inputName: feat.info.source, targetName: null },
+      inputSource: feat.info.source,
+      ...(pairsIn ? { targetSource: pairsIn.info.source } : {}),
+      alive: () => !disposed,
+      onSaved(message) {
+        lastSaved = message;
+        describe();
+      },
+      onLoaded(loaded, message) {
+        model.dispose();
+        model = loaded;
+        replaced = true;
+        fittedRows = -1;
+        lastSaved = message;
+        describe();
+      },
+    };
 
     return {
       process(f, port) {
@@ -373,21 +394,8 @@ export const BatchPredictor = defineBlock({
           label: "Save model",
           description: `Write the model to a file (default ${defaultFile})`,
           run(arg) {
-            const file = fileArg(arg);
-            const text = serializeModel(model, {
-              block: ctx.name,
-              blockType: ctx.type,
-              created: new Date(ctx.now() * 1000).toISOString(),
-              inputSource: feat.info.source,
-              ...(pairsIn ? { targetSource: pairsIn.info.source } : {}),
-            });
-            ctx.resources.writeText(file, text).then(
-              () => {
-                lastSaved = `saved to ${file}`;
-                if (!disposed) describe();
-              },
-              (e: unknown) => ctx.warn(`cannot save the model to ${file}: ${errorMessage(e)}`),
-            );
+            const file = modelFileArg(arg, defaultFile);
+            saveModelFile(files, file);
             return `saving the model to ${file}`;
           },
         },
@@ -395,29 +403,8 @@ export const BatchPredictor = defineBlock({
           label: "Load model",
           description: `Replace the model by one from a file (default ${defaultFile})`,
           run(arg) {
-            const file = fileArg(arg);
-            ctx.resources.readText(file).then(
-              (text) => {
-                if (disposed) return;
-                try {
-                  const r = loadModel(text, file, {
-                    inputs: d,
-                    outputs: M,
-                    inputName: feat.info.source,
-                    targetName: null,
-                  });
-                  model.dispose();
-                  model = r.model;
-                  replaced = true;
-                  fittedRows = -1;
-                  lastSaved = `loaded ${file}: ${describeOptions(r.model.options)}`;
-                  describe();
-                } catch (e) {
-                  ctx.warn(`cannot load the model: ${errorMessage(e)}`);
-                }
-              },
-              (e: unknown) => ctx.warn(`cannot load the model from ${file}: ${errorMessage(e)}`),
-            );
+            const file = modelFileArg(arg, defaultFile);
+            loadModelFile(files, file);
             return `loading ${file}`;
           },
         },

@@ -19,11 +19,14 @@ import {
   legacyMachine,
   listR2,
   loadModel,
+  loadModelFile,
   MODEL_HELP,
+  modelFileArg,
   modelParams,
   ModelFileError,
   optionsFromParams,
-  serializeModel,
+  saveModelFile,
+  type ModelFileHost,
 } from "./model-file";
 
 /** MOSAIC's incremental learning machines (Learning.cs). */
@@ -189,26 +192,36 @@ export const IncrementalPredictor = defineBlock({
     };
     describe();
 
-    const fileArg = (arg: unknown): string =>
-      typeof arg === "string" && arg.trim() !== "" ? arg.trim() : defaultFile;
+    const files: ModelFileHost = {
+      ctx,
+      model: () => model,
+      expect: {
+        inputs: d,
+        outputs: M,
+        inputName: feat.info.source,
+        targetName: tgt?.info.source ?? null,
+      },
+      inputSource: feat.info.source,
+      ...(tgt ? { targetSource: tgt.info.source } : {}),
+      alive: () => !disposed,
+      onSaved(message) {
+        lastSaved = message;
+        describe();
+      },
+      onLoaded(loaded, message) {
+        model.dispose();
+        model = loaded;
+        replaced = true;
+        learntSinceSave = 0;
+        lastSaved = message;
+        describe();
+      },
+    };
 
     const save = (file: string): string => {
       const n = model.samplesSeen();
-      const text = serializeModel(model, {
-        block: ctx.name,
-        blockType: ctx.type,
-        created: new Date(ctx.now() * 1000).toISOString(),
-        inputSource: feat.info.source,
-        ...(tgt ? { targetSource: tgt.info.source } : {}),
-      });
       learntSinceSave = 0;
-      ctx.resources.writeText(file, text).then(
-        () => {
-          lastSaved = `saved to ${file}`;
-          if (!disposed) describe();
-        },
-        (e: unknown) => ctx.warn(`cannot save the model to ${file}: ${errorMessage(e)}`),
-      );
+      saveModelFile(files, file);
       return `saving the model (${plural(n, "sample")}) to ${file}`;
     };
 
@@ -343,36 +356,15 @@ export const IncrementalPredictor = defineBlock({
           label: "Save model",
           description: `Write the model to a file (default ${defaultFile})`,
           run(arg) {
-            return save(fileArg(arg));
+            return save(modelFileArg(arg, defaultFile));
           },
         },
         load: {
           label: "Load model",
           description: `Replace the model by one from a file (default ${defaultFile})`,
           run(arg) {
-            const file = fileArg(arg);
-            ctx.resources.readText(file).then(
-              (text) => {
-                if (disposed) return;
-                try {
-                  const r = loadModel(text, file, {
-                    inputs: d,
-                    outputs: M,
-                    inputName: feat.info.source,
-                    targetName: tgt?.info.source ?? null,
-                  });
-                  model.dispose();
-                  model = r.model;
-                  replaced = true;
-                  learntSinceSave = 0;
-                  lastSaved = `loaded ${file}: ${describeOptions(r.model.options)}`;
-                  describe();
-                } catch (e) {
-                  ctx.warn(`cannot load the model: ${errorMessage(e)}`);
-                }
-              },
-              (e: unknown) => ctx.warn(`cannot load the model from ${file}: ${errorMessage(e)}`),
-            );
+            const file = modelFileArg(arg, defaultFile);
+            loadModelFile(files, file);
             return `loading ${file}`;
           },
         },

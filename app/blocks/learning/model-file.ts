@@ -14,6 +14,7 @@ import {
   LegacyParamsError,
   legacyInteger,
   legacyNumber,
+  type BlockContext,
 } from "../../engine";
 import {
   LEARNING_DEFAULTS,
@@ -688,6 +689,61 @@ export function loadModel(
     );
   }
   return { model: buildModel(f, file), file: f };
+}
+
+/** What a predictor block's `save` and `load` actions need from it. */
+export interface ModelFileHost {
+  ctx: BlockContext;
+  /** The model as it is now (a load replaces it). */
+  model(): LearningModel;
+  /** Sizes and input names a loaded file must match. */
+  expect: { inputs: number; outputs: number | null; inputName: string; targetName: string | null };
+  /** Sources recorded in a saved file's header. */
+  inputSource: string;
+  targetSource?: string;
+  /** False once the block is disposed: a late read or write then changes nothing. */
+  alive(): boolean;
+  /** A save finished (`saved to FILE`) or a load replaced the model (`loaded FILE: …`). */
+  onSaved(message: string): void;
+  onLoaded(model: LearningModel, message: string): void;
+}
+
+/** The action's file argument, or the block's default file. */
+export function modelFileArg(arg: unknown, defaultFile: string): string {
+  return typeof arg === "string" && arg.trim() !== "" ? arg.trim() : defaultFile;
+}
+
+/** Writes the model to `file` in the background; failures become the block's warnings. */
+export function saveModelFile(h: ModelFileHost, file: string): void {
+  const text = serializeModel(h.model(), {
+    block: h.ctx.name,
+    blockType: h.ctx.type,
+    created: new Date(h.ctx.now() * 1000).toISOString(),
+    inputSource: h.inputSource,
+    ...(h.targetSource !== undefined ? { targetSource: h.targetSource } : {}),
+  });
+  h.ctx.resources.writeText(file, text).then(
+    () => {
+      if (h.alive()) h.onSaved(`saved to ${file}`);
+    },
+    (e: unknown) => h.ctx.warn(`cannot save the model to ${file}: ${errorMessage(e)}`),
+  );
+}
+
+/** Reads `file` in the background and hands the checked model to `onLoaded`; else warns. */
+export function loadModelFile(h: ModelFileHost, file: string): void {
+  h.ctx.resources.readText(file).then(
+    (text) => {
+      if (!h.alive()) return;
+      try {
+        const r = loadModel(text, file, h.expect);
+        h.onLoaded(r.model, `loaded ${file}: ${describeOptions(r.model.options)}`);
+      } catch (e) {
+        h.ctx.warn(`cannot load the model: ${errorMessage(e)}`);
+      }
+    },
+    (e: unknown) => h.ctx.warn(`cannot load the model from ${file}: ${errorMessage(e)}`),
+  );
 }
 
 /** Mean of the defined R² values, for status texts: "R² 0.82", or "R² –". */
