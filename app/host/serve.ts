@@ -88,6 +88,17 @@ export async function serve(o: ServeOptions): Promise<Served> {
     wss.handleUpgrade(req, socket, head, (ws) => attach(ws));
   });
 
+  // The hub hands the same message object to every client: encode it once, not once per tab.
+  const encoded = new WeakMap<object, string>();
+  const encode = (msg: object): string => {
+    let text = encoded.get(msg);
+    if (text === undefined) {
+      text = encodeWire(msg);
+      encoded.set(msg, text);
+    }
+    return text;
+  };
+
   const attach = (ws: WebSocket): void => {
     const conn = hub.connect({
       send(msg) {
@@ -95,7 +106,7 @@ export async function serve(o: ServeOptions): Promise<Served> {
         // Panel data is best effort: a tab that cannot keep up (hidden, slow) skips frames
         // rather than queueing without bound.
         if (msg.type === "data" && ws.bufferedAmount > 4 * 1024 * 1024) return;
-        ws.send(encodeWire(msg));
+        ws.send(encode(msg));
       },
     });
     ws.on("message", (data, isBinary) => {
