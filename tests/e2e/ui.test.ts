@@ -177,6 +177,17 @@ describe.skipIf(!haveChromium)("browser build, end to end (Chromium)", () => {
         .querySelector('[data-edge-label="Timer->Emg"]')
         ?.textContent?.includes("200 Hz"),
     );
+    // The rate estimate settles within the first second or two (the first intervals are short).
+    await page.waitForFunction(
+      () =>
+        /2[45]\.\d Hz/.test(
+          (globalThis as unknown as InPage).document.querySelector(
+            '[data-edge-label="Pace->Envelope"]',
+          )?.textContent ?? "",
+        ),
+      undefined,
+      { timeout: 5000 },
+    );
     expect(await page.textContent('[data-edge-label="Pace->Envelope"]')).toMatch(/2[45]\.\d Hz/);
     // The status is also written (colour is never the only signal), and the timing precision shown.
     expect(await page.textContent('.block-node[data-block="Emg"] .block-node__status')).toContain(
