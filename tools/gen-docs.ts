@@ -42,6 +42,7 @@ const WORKER_PATTERN = "^[A-Za-z_][A-Za-z0-9_-]*$";
 const INPUT_PATTERN = "^-?[A-Za-z_][A-Za-z0-9_-]*(\\.[A-Za-z0-9_-]+)?$";
 const QUEUE_POLICIES = ["drop-oldest", "drop-newest", "latest"];
 const MAX_QUEUE_CAPACITY = 1 << 24;
+const SETTINGS_KEY = "Pipeline";
 
 type JsonSchema = { [key: string]: unknown };
 
@@ -204,6 +205,7 @@ function pipelineSchema(blocks: readonly AnyBlockDefinition[]): JsonSchema {
         },
         additionalProperties: false,
       },
+      BatchingMs: BATCHING_MS,
     },
     required: ["Type"],
     additionalProperties: false,
@@ -216,11 +218,33 @@ function pipelineSchema(blocks: readonly AnyBlockDefinition[]): JsonSchema {
     description:
       "A MOSAIC pipeline: a mapping from block name to block. Generated from the block catalog by tools/gen-docs.ts (npm run docs); do not edit.",
     type: "object",
+    properties: {
+      [SETTINGS_KEY]: {
+        description:
+          "Settings of the whole pipeline (reserved name; a block named Pipeline needs a Type).",
+        anyOf: [
+          {
+            type: "object",
+            properties: { BatchingMs: BATCHING_MS },
+            additionalProperties: false,
+          },
+          { $ref: "#/definitions/Block" },
+        ],
+      },
+    },
     patternProperties: { [BLOCK_NAME_PATTERN]: { $ref: "#/definitions/Block" } },
     additionalProperties: false,
     definitions: { Block: block, ...definitions },
   };
 }
+
+const BATCHING_MS: JsonSchema = {
+  description:
+    "How long a timer's ticks may wait to go out together, in ms (DESIGN.md §3): the worker wakes at most once per interval and fires every tick due, as a device delivers packets. 0 wakes for every tick. In `Pipeline:` the default for every block (2 ms when unset); on a block, that block's own.",
+  type: "number",
+  minimum: 0,
+  maximum: 1000,
+};
 
 // ------------------------------------------------------------------------------------------------
 // Markdown

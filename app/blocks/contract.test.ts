@@ -32,9 +32,11 @@ import {
   type AnyBlockDefinition,
   type BlockContext,
   type BlockInstance,
+  type CatchUp,
   type IoBridges,
   type Resources,
   type Shape,
+  type TickCallback,
 } from "../engine";
 import { BlockHarness } from "../engine/testing";
 import { memoryResources } from "../../tests/support/fs-resources";
@@ -770,7 +772,7 @@ function guarded(def: AnyBlockDefinition, list: Failure[]): AnyBlockDefinition {
   };
   const wrapInstance = (inst: BlockInstance): BlockInstance => {
     const w: BlockInstance = {};
-    const methods = ["process", "start", "stop", "reset", "dispose", "setParam"] as const;
+    const methods = ["process", "flush", "start", "stop", "reset", "dispose", "setParam"] as const;
     for (const m of methods) {
       const f = inst[m] as ((...a: unknown[]) => unknown) | undefined;
       if (f)
@@ -808,8 +810,8 @@ function guarded(def: AnyBlockDefinition, list: Failure[]): AnyBlockDefinition {
       : {}),
     async create(ctx: BlockContext, params: unknown) {
       const g = Object.create(ctx) as BlockContext & Record<string, unknown>;
-      g.every = (hz: number, tick: (t: number) => void) =>
-        ctx.every(hz, (t) => guard("timer", () => tick(t)));
+      g.every = (hz: number, tick: TickCallback, options?: { catchUp?: CatchUp }) =>
+        ctx.every(hz, (t, n) => guard("timer", () => tick(t, n)), options);
       g.at = (t: number, fn: (t: number) => void) =>
         ctx.at(t, (x) => guard("one-shot", () => fn(x)));
       try {

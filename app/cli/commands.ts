@@ -32,7 +32,7 @@ Usage:
       never written: its messages are printed (file:line:col) and the exit code is 2. --check
       writes nothing and lists the files that would change (exit 1).
   mosaic run FILE [--duration S] [--clock realtime|virtual] [--json] [--precision]
-                  [--log-dir DIR] [--start T] [--warmup S]
+                  [--batching-ms MS] [--log-dir DIR] [--start T] [--warmup S]
       Runs a pipeline and shows a live per-block table: desired and actual rate, status
       (on time, lagging, stumbling, idle), compute time and drops. --json prints one JSON object
       per line instead (telemetry at 20 Hz, events, a final summary). Ctrl-C stops cleanly and
@@ -40,6 +40,9 @@ Usage:
         --duration S   stop after S seconds (virtual seconds with --clock virtual)
         --clock        realtime (default) or virtual (as fast as possible, deterministic)
         --precision    spin the last ~0.3 ms before each tick (less jitter, more CPU)
+        --batching-ms MS  how long timer ticks may wait to go out together (default: the
+                       file's Pipeline: { BatchingMs }, else 2); 0 wakes for every tick.
+                       Blocks with their own BatchingMs keep it.
         --log-dir DIR  base folder for relative Path logs (default: the pipeline's folder)
         --start T      virtual clock start time, UNIX seconds (default 0)
         --warmup S     reset the timing statistics (ΔT, lateness) after S seconds
@@ -176,6 +179,7 @@ async function cmdRun(args: string[]): Promise<number> {
       clock: { type: "string", default: "realtime" },
       json: { type: "boolean", default: false },
       precision: { type: "boolean", default: false },
+      "batching-ms": { type: "string" },
       "log-dir": { type: "string" },
       start: { type: "string" },
       warmup: { type: "string" },
@@ -212,6 +216,14 @@ async function cmdRun(args: string[]): Promise<number> {
     err(`mosaic run: --telemetry-hz must be between 0 and 100, not '${values["telemetry-hz"]}'`);
     return 2;
   }
+  const batchingMs =
+    values["batching-ms"] !== undefined ? Number(values["batching-ms"]) : undefined;
+  if (batchingMs !== undefined && !(batchingMs >= 0 && batchingMs <= 1000)) {
+    err(
+      `mosaic run: --batching-ms must be between 0 and 1000 milliseconds, not '${values["batching-ms"]}'`,
+    );
+    return 2;
+  }
   const json = values.json;
   const tty = process.stdout.isTTY === true && !json;
   const color = tty && !process.env.NO_COLOR;
@@ -234,6 +246,7 @@ async function cmdRun(args: string[]): Promise<number> {
     {
       mode,
       precision: values.precision,
+      ...(batchingMs !== undefined ? { batchingS: batchingMs / 1000 } : {}),
       ...(values["log-dir"] !== undefined ? { logDir: resolve(values["log-dir"]) } : {}),
       virtualStart: start,
       telemetryHz,

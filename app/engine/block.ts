@@ -10,6 +10,7 @@ import type { z } from "zod";
 import type { Frame, Shape } from "./frame";
 import type { IoBridges } from "./io";
 import type { LogChannel } from "./runtime/logsink";
+import type { CatchUp, TickCallback } from "./runtime/scheduler";
 
 export type BlockCategory =
   | "Timing"
@@ -70,9 +71,9 @@ export interface TimerHandle {
   start(): void;
   stop(): void;
   readonly running: boolean;
-  /** Ticks fired since creation. */
+  /** Ticks delivered since creation. */
   readonly fired: number;
-  /** Ticks skipped because the worker woke too late (never fired late in a burst). */
+  /** Ticks skipped after a stall (only with `catchUp: "skip"`; otherwise every tick goes out). */
   readonly missed: number;
   setRate(hz: number): void;
 }
@@ -109,8 +110,18 @@ export interface BlockContext {
   readonly io: IoBridges;
   /** Declares an output port (the first declared port is the default one). */
   output(shape: Shape, port?: string): OutputPort;
-  /** A periodic callback on the high-resolution scheduler; missed ticks are skipped and counted. */
-  every(hz: number, tick: (t: number) => void): TimerHandle;
+  /**
+   * The batching interval that applies to this block, s (DESIGN.md §3): its timers' ticks may
+   * wait this long to go out together. Self-timed sources (`at`) may batch the same way.
+   */
+  readonly batching: number;
+  /**
+   * A periodic callback on the high-resolution scheduler, lossless: each call receives every
+   * tick due since the previous one (`n` ≥ 1), their deadlines in `times[0 … n)` (base + k / hz;
+   * read them during the call). With `catchUp: "skip"` a call after a stall gets only the newest
+   * tick and the skipped ones are counted as missed.
+   */
+  every(hz: number, tick: TickCallback, options?: { catchUp?: CatchUp }): TimerHandle;
   /** A one-shot callback at clock time `t`; a later call replaces a pending one. */
   at(t: number, fn: (t: number) => void): void;
   /** One line of live status text ("waiting for device", "row 120/2000"). */
@@ -147,6 +158,12 @@ export interface BlockAction {
 
 export interface BlockInstance {
   process?(frame: Frame, port: number): void;
+  /**
+   * Called when the worker has delivered everything queued in a step, for blocks that hold events
+   * back while the same step may still deliver what they wait for (a Resampler's tick waits for
+   * the signal events of its own time). Emit what is still held; do nothing when nothing is.
+   */
+  flush?(): void;
   start?(): void;
   stop?(): void;
   /** Clears internal state: after reset the block behaves as if just created. */

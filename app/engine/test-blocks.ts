@@ -20,9 +20,9 @@ export const TestTimer = defineBlock({
   timer: true,
   create(ctx) {
     const out = ctx.output(EMPTY_SHAPE);
-    const t = ctx.every(ctx.desiredRate, (time) => {
-      const f = out.frame(1);
-      f.t[0] = time;
+    const t = ctx.every(ctx.desiredRate, (times, n) => {
+      const f = out.frame(n);
+      for (let i = 0; i < n; i++) f.t[i] = times[i]!;
       out.emit(f);
     });
     return { start: () => t.start(), stop: () => t.stop() };

@@ -19,6 +19,7 @@ import { Frame, FramePool, type Shape } from "./frame";
 import { loadPipeline } from "./pipeline/loader";
 import { MemoryLogSink } from "./runtime/logsink";
 import { Runtime, type Telemetry } from "./runtime/runtime";
+import type { CatchUp, TickCallback } from "./runtime/scheduler";
 import { runVirtual } from "./runtime/virtual";
 
 export interface Recorded {
@@ -122,6 +123,8 @@ export interface HarnessOptions {
   resources?: Resources;
   io?: IoBridges;
   virtual?: boolean;
+  /** What `ctx.batching` reports (s, default 0). */
+  batchingS?: number;
 }
 
 /**
@@ -132,7 +135,12 @@ export class BlockHarness {
   readonly out = new Map<string, Recorded>();
   readonly ports: OutputPort[] = [];
   instance!: BlockInstance;
-  readonly timers: { hz: number; tick: (t: number) => void; running: boolean }[] = [];
+  readonly timers: {
+    hz: number;
+    tick: TickCallback;
+    running: boolean;
+    catchUp: CatchUp;
+  }[] = [];
   oneShot: { t: number; fn: (t: number) => void } | null = null;
   text = "";
   warnings: string[] = [];
@@ -217,8 +225,16 @@ export class BlockHarness {
         h.ports.push(p);
         return p;
       },
-      every(hz: number, tick: (t: number) => void): TimerHandle {
-        const entry = { hz, tick, running: false, fired: 0, missed: 0 };
+      batching: this.opts.batchingS ?? 0,
+      every(hz: number, tick: TickCallback, options?: { catchUp?: CatchUp }): TimerHandle {
+        const entry = {
+          hz,
+          tick,
+          running: false,
+          fired: 0,
+          missed: 0,
+          catchUp: options?.catchUp ?? "all",
+        };
         h.timers.push(entry);
         return {
           start: () => {
@@ -275,12 +291,21 @@ export class BlockHarness {
   /** Delivers a frame to input `port`. */
   push(frame: Frame, port = 0): void {
     this.instance.process?.(frame, port);
+    // Each push is a step of its own: blocks holding events for the step's end release them.
+    this.instance.flush?.();
   }
 
   /** Fires every running timer once at time t. */
   tick(t: number): void {
-    this.clock = t;
-    for (const e of this.timers) if (e.running) e.tick(t);
+    this.ticks([t]);
+  }
+
+  /** Fires every running timer with one batch of ticks at these times (the clock ends at the last). */
+  ticks(times: readonly number[]): void {
+    if (times.length === 0) return;
+    this.clock = times[times.length - 1]!;
+    const batch = Float64Array.from(times);
+    for (const e of this.timers) if (e.running) e.tick(batch, batch.length);
   }
 
   /** Fires the pending one-shot, if any, at its time. */

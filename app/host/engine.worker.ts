@@ -113,6 +113,7 @@ async function create(msg: InitMessage): Promise<void> {
     logs: sabLogSink(virtual),
     worker: msg.worker,
     ...(msg.plan ? { plan: msg.plan } : {}),
+    ...(msg.batchingS !== undefined ? { batchingS: msg.batchingS } : {}),
     ignorePlacement: virtual,
   });
   const diagnostics: Diagnostic[] = [...loaded.diagnostics, ...created.diagnostics];

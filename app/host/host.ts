@@ -28,6 +28,11 @@ export interface HostOptions {
   virtualStart?: number;
   virtualDuration?: number;
   telemetryHz?: number;
+  /**
+   * The batching interval, s, for blocks that do not set their own: overrides the pipeline's
+   * `Pipeline: { BatchingMs }` (undefined: the file's, else the default).
+   */
+  batchingS?: number;
   workerPath?: string;
   wasmPath?: string;
 }
@@ -114,7 +119,10 @@ export class Host {
 
   private constructor(
     readonly file: string,
-    readonly options: Required<Omit<HostOptions, "logDir">> & { logDir: string },
+    readonly options: Required<Omit<HostOptions, "logDir" | "batchingS">> & {
+      logDir: string;
+      batchingS: number | undefined;
+    },
   ) {
     this.logWriter = new LogWriter(
       options.logDir,
@@ -162,6 +170,7 @@ export class Host {
       virtualStart: opts.virtualStart ?? 0,
       virtualDuration: opts.virtualDuration ?? Infinity,
       telemetryHz: opts.telemetryHz ?? 20,
+      batchingS: opts.batchingS,
       workerPath: opts.workerPath ?? defaultWorkerPath(),
       wasmPath: opts.wasmPath ?? defaultWasmPath(),
     });
@@ -181,6 +190,7 @@ export class Host {
       ...(plan ? { plan } : {}),
       precision: host.options.precision,
       telemetryHz: host.options.telemetryHz,
+      ...(host.options.batchingS !== undefined ? { batchingS: host.options.batchingS } : {}),
     });
     // The main worker instantiates everything once to learn shapes and rates (the plan).
     const main = host.spawn("main");

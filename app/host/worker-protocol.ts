@@ -24,6 +24,8 @@ export interface InitMessage {
   plan?: Plan;
   precision: boolean;
   telemetryHz: number;
+  /** Batching interval for blocks without their own `BatchingMs`, s (the CLI's --batching-ms). */
+  batchingS?: number;
 }
 
 export interface LinkMessage {

@@ -1,6 +1,7 @@
 import { describe, expect, test } from "vitest";
+import { catalog } from "../catalog";
 import { EMPTY_SHAPE, matrixShape, vectorShape } from "../../engine";
-import { BlockHarness } from "../../engine/testing";
+import { BlockHarness, runVirtualPipeline } from "../../engine/testing";
 import { loadBlock, matrices, ticks, vectors } from "../../../tests/support/blocks";
 import { Resampler } from "./resampler";
 
@@ -90,6 +91,40 @@ describe("Resampler", () => {
     expect(h.text).toBe("waiting for in0");
     h.push(ticks(2), 1);
     expect(h.output().t).toEqual([1]);
+  });
+
+  test("a tick takes the signal sample of its own time, however the step batches and orders them", async () => {
+    const run = async (batchingMs: number, timerFirst: boolean) => {
+      const inputs = timerFirst ? "[Slow, Sig]" : "[Sig, Slow]";
+      const r = await runVirtualPipeline(
+        `Pipeline: { BatchingMs: ${batchingMs} }\n` +
+          "Timer: { Type: ScheduledTimer, DesiredRate: 1926 }\n" +
+          "Slow: { Type: DecimatorTimer, DesiredRate: 25, Inputs: [Timer] }\n" +
+          "Sig: { Type: SinGenerator, Inputs: [Timer], Params: { Frequency: 3 } }\n" +
+          `R: { Type: Resampler, Inputs: ${inputs} }\n`,
+        { catalog, duration: 2, start: 100 },
+      );
+      return { sig: r.outputs.get("Sig")!, r: r.outputs.get("R")!, timer: r.outputs.get("Timer")! };
+    };
+    const base = await run(0, false);
+    expect(base.r.t.length).toBe(51);
+    // Every tick holds exactly the signal sample stamped at its time (the sample of that tick).
+    base.r.t.forEach((t, i) => {
+      const k = base.sig.t.indexOf(t);
+      expect(k).toBeGreaterThanOrEqual(0);
+      expect(base.r.v[i]).toEqual(base.sig.v[k]);
+    });
+    for (const [ms, timerFirst] of [
+      [0, true],
+      [2, false],
+      [5, true],
+      [13.5, false],
+    ] as const) {
+      const other = await run(ms, timerFirst);
+      expect(other.r.t).toEqual(base.r.t);
+      expect(other.r.v).toEqual(base.r.v);
+      if (ms > 0) expect(Math.max(...other.timer.frames)).toBeGreaterThan(1);
+    }
   });
 
   test("exactly one input must be a timer", async () => {

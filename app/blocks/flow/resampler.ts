@@ -1,6 +1,8 @@
 import { z } from "zod";
 import { BlockConfigError, defineBlock } from "../../engine";
 import { inputName, signalInput } from "../shared/inputs";
+import { SampleQueue } from "./sample-queue";
+import { TickQueue } from "./tick-queue";
 
 export const Resampler = defineBlock({
   type: "Resampler",
@@ -8,11 +10,14 @@ export const Resampler = defineBlock({
   summary: "Sample-and-hold: on every tick of its timer, emits the latest value of its signal.",
   help:
     "Changes the rate of a stream with a sample-and-hold (paper Table 3): it has two inputs, a " +
-    "signal and a timer, in either order. On every timer tick it emits the signal's most recent " +
-    "value, stamped with the tick's time; ticks before the signal's first value emit nothing. " +
-    "With `Mode: mean` it emits instead the mean of the signal values received since the " +
-    "previous tick (an anti-aliasing average when downsampling), and holds the latest value when " +
-    "none arrived. Its desired rate is the timer's.",
+    "signal and a timer, in either order. On every timer tick it emits the signal's value at the " +
+    "tick's time — the latest signal event stamped at or before the tick — stamped with the " +
+    "tick's time; ticks before the signal's first value emit nothing. A tick waits for the " +
+    "signal events of its own time that the same step is still delivering (so the result does " +
+    "not depend on delivery order or on how events are batched), never longer. With " +
+    "`Mode: mean` it emits instead the mean of the signal values stamped since the previous " +
+    "tick (an anti-aliasing average when downsampling), and holds the latest value when none " +
+    "arrived. Its desired rate is the timer's.",
   params: z.strictObject({
     Mode: z
       .enum(["hold", "mean"])
@@ -45,57 +50,52 @@ export const Resampler = defineBlock({
     if (ctx.declaredRate === undefined) ctx.setDesiredRate(timers[0]!.rate);
     const out = ctx.output(sig.shape);
     const mean = p.Mode === "mean";
-    const latest = new Float64Array(size);
-    const sum = new Float64Array(size);
-    let count = 0;
-    let seen = false;
+    const queue = new SampleQueue(size);
+    const ticks = new TickQueue();
     const waiting = `waiting for ${sig.info.source}`;
     ctx.setText(waiting);
+
+    /** Emits the pending ticks stamped at or before `until` (all of them when Infinity). */
+    const emitTicks = (until: number): void => {
+      const m = ticks.countUntil(until);
+      if (m === 0) return;
+      const o = out.frame(m);
+      const ov = o.v;
+      let j = 0;
+      for (let e = 0; e < m; e++) {
+        const t = ticks.shift();
+        queue.consumeUntil(t);
+        if (!queue.holding) continue;
+        o.t[j] = t;
+        if (mean) queue.takeMean(ov, j * size);
+        else ov.set(queue.held, j * size);
+        j++;
+      }
+      o.n = j;
+      out.emit(o);
+    };
+
     return {
       process(f, port) {
         const n = f.n;
+        if (n === 0) return;
         if (port === signalPort) {
-          if (n === 0) return;
-          const v = f.v;
-          if (mean) {
-            for (let e = 0; e < n; e++) {
-              const off = e * size;
-              for (let k = 0; k < size; k++) sum[k] += v[off + k]!;
-            }
-            count += n;
-          }
-          const last = (n - 1) * size;
-          for (let k = 0; k < size; k++) latest[k] = v[last + k]!;
-          if (!seen) {
-            seen = true;
-            ctx.setText("");
-          }
+          if (queue.length === 0 && !queue.holding) ctx.setText("");
+          queue.push(f.t, f.v, n);
+          // Every event up to the newest has arrived (events come in order): those ticks can go.
+          emitTicks(queue.newest);
           return;
         }
-        if (!seen || n === 0) return;
-        const o = out.frame(n);
-        const ov = o.v;
-        const ft = f.t;
-        for (let e = 0; e < n; e++) {
-          o.t[e] = ft[e]!;
-          const off = e * size;
-          if (e === 0 && count > 0) {
-            for (let k = 0; k < size; k++) {
-              ov[off + k] = sum[k]! / count;
-              sum[k] = 0;
-            }
-            count = 0;
-          } else {
-            for (let k = 0; k < size; k++) ov[off + k] = latest[k]!;
-          }
-        }
-        out.emit(o);
+        ticks.push(f.t, n);
+        emitTicks(queue.length > 0 ? queue.newest : -Infinity);
+      },
+      flush() {
+        // The step delivered everything it had: what is still waiting goes out now.
+        emitTicks(Infinity);
       },
       reset() {
-        latest.fill(0);
-        sum.fill(0);
-        count = 0;
-        seen = false;
+        queue.clear();
+        ticks.clear();
         ctx.setText(waiting);
       },
     };

@@ -32,6 +32,7 @@ describe("ScheduledTimer", () => {
       convertLegacy("T: { Type: ScheduledTimer, DesiredRate: 200, Params: [x] }", "T"),
     ).toEqual({
       Autostart: true,
+      CatchUp: "all",
     });
   });
 });

@@ -6,13 +6,23 @@ export const ScheduledTimer = defineBlock({
   category: "Timing",
   summary: "Paces the pipeline: emits a tick at DesiredRate from the high-resolution scheduler.",
   help:
-    "The primary timing source (paper III-D). Ticks come from one high-resolution clock; a tick " +
-    "whose deadline has already passed by a whole period is skipped and counted as missed rather " +
-    "than fired late in a burst. Ticks carry no values; their timestamps are the times they fired " +
-    "(virtual time under the virtual clock). Right-click actions start and stop it; with " +
-    "`Autostart: false` it waits for the start action.",
+    "The primary timing source (paper III-D). Tick k is due at start + k / DesiredRate on one " +
+    "high-resolution clock and is stamped with that deadline. It never loses a tick: when its " +
+    "worker wakes, every tick due since the last one goes out as one frame of n events, the way " +
+    "a device delivers a packet of samples. The worker wakes at most once per batching interval " +
+    "(`BatchingMs`, default 2 ms; 0 wakes for every tick). `CatchUp: skip` is for control-rate " +
+    "timers whose stale ticks are worthless: after a stall only the newest tick goes out and " +
+    "the others are counted as missed. Ticks carry no values. Right-click actions start and stop " +
+    "it; with `Autostart: false` it waits for the start action.",
   params: z.strictObject({
     Autostart: z.boolean().default(true).describe("Start ticking when the pipeline starts"),
+    CatchUp: z
+      .enum(["all", "skip"])
+      .default("all")
+      .describe(
+        "After a stall: all = every due tick goes out (lossless, for acquisition); skip = only " +
+          "the newest, the others counted as missed (control-rate timers)",
+      ),
   }),
   legacyParams: () => ({}),
   legacyForm: "no params: `{ Type: ScheduledTimer, DesiredRate: 200 }`",
@@ -22,11 +32,16 @@ export const ScheduledTimer = defineBlock({
   panel: "Actual rate, ticks fired and missed, lateness percentiles; start/stop buttons.",
   create(ctx, p) {
     const out = ctx.output(EMPTY_SHAPE);
-    const timer = ctx.every(ctx.desiredRate, (t) => {
-      const f = out.frame(1);
-      f.t[0] = t;
-      out.emit(f);
-    });
+    const timer = ctx.every(
+      ctx.desiredRate,
+      (times, n) => {
+        const f = out.frame(n);
+        const t = f.t;
+        for (let i = 0; i < n; i++) t[i] = times[i]!;
+        out.emit(f);
+      },
+      { catchUp: p.CatchUp },
+    );
     const describe = () => {
       ctx.setText(
         timer.running ? (timer.missed > 0 ? `missed ${timer.missed} ticks` : "") : "stopped",

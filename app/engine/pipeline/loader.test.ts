@@ -55,6 +55,45 @@ G: { Type: Gain, Inputs: [C], Params: [ gain:2, 1;2;3 ] }
   });
 });
 
+describe("loader: batching settings", () => {
+  test("Pipeline: { BatchingMs } sets the pipeline's interval; a block's own BatchingMs overrides it", () => {
+    const r = load(`
+Pipeline: { BatchingMs: 5 }
+T: { Type: Tick, DesiredRate: 100, BatchingMs: 0 }
+C: { Type: Counter, Inputs: [T] }
+`);
+    expect(r.diagnostics).toEqual([]);
+    expect(r.spec!.settings.batchingMs).toBe(5);
+    expect(r.spec!.byName.get("T")!.batchingMs).toBe(0);
+    expect(r.spec!.byName.get("C")!.batchingMs).toBeUndefined();
+    expect(r.spec!.blocks.map((b) => b.name)).toEqual(["T", "C"]);
+  });
+
+  test("a block named Pipeline (with a Type) is still a block", () => {
+    const r = load(
+      `Pipeline: { Type: Tick, DesiredRate: 10 }\nC: { Type: Counter, Inputs: [Pipeline] }\n`,
+    );
+    expect(r.ok).toBe(true);
+    expect(r.spec!.settings.batchingMs).toBeUndefined();
+    expect(r.spec!.byName.get("Pipeline")!.type).toBe("Tick");
+  });
+
+  test("bad values and unknown settings are positioned errors", () => {
+    const e1 = errors(`Pipeline: { BatchingMs: -1 }\nT: { Type: Tick, DesiredRate: 10 }\n`);
+    expect(e1.map(formatDiagnostic)).toEqual([
+      "p.yaml:1:25: error: Pipeline: BatchingMs has number -1 (expected milliseconds from 0 (wake up for every tick) to 1000, e.g. \`BatchingMs: 2\`)",
+    ]);
+    const e2 = errors(`Pipeline: { Batching: 2 }\nT: { Type: Tick, DesiredRate: 10 }\n`);
+    expect(e2).toHaveLength(1);
+    expect(e2[0]!.message).toBe("Pipeline: unknown setting 'Batching'");
+    expect(e2[0]!.suggestion).toBe("BatchingMs");
+    const e3 = errors(`T: { Type: Tick, DesiredRate: 10, BatchingMs: fast }\n`);
+    expect(e3).toHaveLength(1);
+    expect(e3[0]!.block).toBe("T");
+    expect(e3[0]!.col).toBe(47);
+  });
+});
+
 describe("loader: each invalid file gives one clear, positioned message", () => {
   test("unknown type with a near-miss name", () => {
     const e = errors(`T: { Type: Tick, DesiredRate: 10 }\nC: { Type: Countr, Inputs: [T] }\n`);

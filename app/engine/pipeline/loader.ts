@@ -56,6 +56,8 @@ export interface BlockSpec {
   /** Log this block's output (folder, or a file when it has an extension). */
   path: string | undefined;
   worker: string;
+  /** `BatchingMs`: this block's timers' batching interval, ms (overrides the pipeline's). */
+  batchingMs: number | undefined;
   queue: QueueSpec;
   layout: { x: number; y: number } | undefined;
   /** Output port names (first is the default). */
@@ -68,10 +70,17 @@ export interface BlockSpec {
   paramPos: Record<string, SourcePos>;
 }
 
+/** Settings of the whole pipeline: the reserved top-level entry `Pipeline: { … }`. */
+export interface PipelineSettings {
+  /** `BatchingMs`: how long a timer's ticks may wait to go out together, ms (DESIGN.md §3). */
+  batchingMs: number | undefined;
+}
+
 export interface PipelineSpec {
   file: string;
   blocks: BlockSpec[];
   byName: Map<string, BlockSpec>;
+  settings: PipelineSettings;
 }
 
 export interface LoadResult {
@@ -91,7 +100,11 @@ const BLOCK_KEYS = [
   "Layout",
   "Worker",
   "Queue",
+  "BatchingMs",
 ] as const;
+/** The reserved top-level name for pipeline settings (a mapping without `Type`). */
+export const SETTINGS_KEY = "Pipeline";
+const SETTINGS_KEYS = ["BatchingMs"] as const;
 export const BLOCK_NAME_RE = /^[A-Za-z_][A-Za-z0-9_-]*$/;
 const WORKER_RE = /^[A-Za-z_][A-Za-z0-9_-]*$/;
 
@@ -362,11 +375,16 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
   const blocks: BlockSpec[] = [];
   const byName = new Map<string, BlockSpec>();
   const typeNames = [...catalog].filter(([n, d]) => n === d.type).map(([n]) => n);
+  const settings: PipelineSettings = { batchingMs: undefined };
 
   for (const pair of (root as YAMLMap).items) {
     const keyNode = pair.key as YamlNode | null;
     const at = c.pos(keyNode);
     const name = scalarString(keyNode);
+    if (isSettingsEntry(name, pair.value)) {
+      readSettings(c, pair.value as YAMLMap, settings);
+      continue;
+    }
     if (name === undefined || name === "") {
       c.error("bad-name", at, "a block name must be a plain word", {
         expected: "a name like `LowPass`",
@@ -580,6 +598,9 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
         worker = s;
       }
     }
+
+    const batchingEntry = get("BatchingMs");
+    const batchingMs = batchingEntry ? readBatchingMs(c, batchingEntry.node, name) : undefined;
 
     // Queue
     const queue: QueueSpec = { policy: "drop-oldest", capacity: undefined };
@@ -809,6 +830,7 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
       inputs,
       path,
       worker,
+      batchingMs,
       queue,
       layout,
       outputs,
@@ -887,5 +909,54 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
     c.error("empty", { line: 1, col: 1 }, "the pipeline has no blocks");
   }
   const ok = c.errors === 0;
-  return { spec: ok ? { file, blocks, byName } : undefined, diagnostics: c.list, ok, doc };
+  return {
+    spec: ok ? { file, blocks, byName, settings } : undefined,
+    diagnostics: c.list,
+    ok,
+    doc,
+  };
+}
+
+/** `Pipeline: { … }` without a `Type` is the settings entry (a block may still be named Pipeline). */
+function isSettingsEntry(name: string | undefined, value: unknown): boolean {
+  return (
+    name === SETTINGS_KEY &&
+    isMap(value) &&
+    !value.items.some((it) => scalarString(it.key) === "Type")
+  );
+}
+
+function readSettings(c: Collector, node: YAMLMap, settings: PipelineSettings): void {
+  for (const it of node.items) {
+    const k = scalarString(it.key) ?? "";
+    if (k === "BatchingMs") {
+      settings.batchingMs = readBatchingMs(c, it.value, undefined);
+      continue;
+    }
+    const suggestion = closest(k, SETTINGS_KEYS);
+    c.error("unknown-key", c.pos(it.key as YamlNode), `${SETTINGS_KEY}: unknown setting '${k}'`, {
+      expected: `one of ${SETTINGS_KEYS.join(", ")} (a block named ${SETTINGS_KEY} needs a Type)`,
+      ...(suggestion !== undefined ? { suggestion } : {}),
+    });
+  }
+}
+
+/** `BatchingMs`: a number of milliseconds, 0 (a wake-up per tick) to 1000. */
+function readBatchingMs(
+  c: Collector,
+  node: unknown,
+  block: string | undefined,
+): number | undefined {
+  const v = isScalar(node) ? node.value : undefined;
+  if (typeof v === "number" && Number.isFinite(v) && v >= 0 && v <= 1000) return v;
+  c.error(
+    "bad-batching",
+    c.pos(node as YamlNode),
+    `${block !== undefined ? `block '${block}'` : SETTINGS_KEY}: BatchingMs has ${describeNode(node)}`,
+    {
+      ...(block !== undefined ? { block } : {}),
+      expected: "milliseconds from 0 (wake up for every tick) to 1000, e.g. `BatchingMs: 2`",
+    },
+  );
+  return undefined;
 }

@@ -2,25 +2,28 @@
  * The real-time loop of an engine worker (DESIGN.md §3 Scheduling), for Node worker_threads and
  * for browser Web Workers with shared memory (cross-origin isolated pages).
  *
- * Between deadlines the worker blocks in `Atomics.wait` on its doorbell and wakes slightly before
- * the deadline — "slightly" is learned from the observed wake-up overshoot, so ticks land on time
- * without spinning; precision mode spins the last ~0.3 ms instead. Frames from other workers and
- * control messages ring the doorbell, so they wake the worker at once. Missed deadlines are
- * skipped and counted by the scheduler, never fired in a burst.
+ * The worker wakes when the scheduler asks (`Runtime.nextDeadline`: with batching, the deadline of
+ * the last tick that may wait for the others, so one wake-up fires several ticks of every timer)
+ * and runs everything due. Between wake-ups it blocks in `Atomics.wait` on its doorbell and wakes
+ * slightly before the target — "slightly" is learned from the observed wake-up overshoot, so
+ * ticks land on time without spinning; precision mode spins the last ~0.3 ms instead. Frames from
+ * other workers and control messages ring the doorbell, so they wake the worker at once.
  *
  * Wake-ups are the main cost of a timer (on the 2-core VM of the benches a bare 2 kHz sleep loop
- * costs ~4–5 % of a core, whatever the language), so the loop avoids extra ones:
+ * costs ~2–5 % of a core, whatever the language), so the loop avoids extra ones:
  * - a worker without I/O blocks yields to its event loop only when a control message is waiting,
- *   or every YIELD_S, not after every tick;
+ *   or every YIELD_S, not after every wake-up;
  * - a worker with I/O blocks (`eventLoop: true`, e.g. a UDP receiver) sleeps in its event loop
- *   (`Atomics.waitAsync`) while the next deadline is far, so a datagram wakes it at once, and only
- *   the last COARSE_S before a deadline are spent in `Atomics.wait`.
+ *   (`Atomics.waitAsync`, whose timeout is precise to ~0.1 ms in Node) until just before the
+ *   target, so a datagram wakes it at once; the learned overshoot of that wait is the only part
+ *   spent blocked in `Atomics.wait`. It never polls.
  */
 import type { Clock } from "../clock";
 import type { Runtime } from "./runtime";
 
-const COARSE_S = 0.002;
 const PRECISION_SPIN_S = 0.0003;
+/** Longest blocking wait left after an event-loop sleep (beyond it, sleep in the event loop again). */
+const MAX_ASYNC_MARGIN_S = 0.001;
 const MAX_MARGIN_S = 0.0002;
 /** Longest blocking wait, and longest time between event-loop turns, for workers without I/O. */
 const MAX_BLOCK_S = 0.02;
@@ -49,6 +52,8 @@ export class RealtimeLoop {
   private lastYield = -Infinity;
   /** EWMA of how late Atomics.wait returns after its timeout (s). */
   private overshoot = 0.00006;
+  /** EWMA of how late Atomics.waitAsync resolves after its timeout (s). */
+  private asyncOvershoot = 0.00015;
   private finishedReported = false;
   private readonly eventLoop: boolean;
 
@@ -102,6 +107,10 @@ export class RealtimeLoop {
   /** One turn of the event loop: step, then wait (blocking) until the loop must yield again. */
   private readonly turn = (): void => {
     if (this.stopped) return;
+    if (this.eventLoop && typeof Atomics.waitAsync === "function") {
+      this.ioTurn();
+      return;
+    }
     const { clock, doorbell } = this.o;
     this.lastYield = clock.now();
     Atomics.store(doorbell, BELL_CONTROL, 0);
@@ -110,18 +119,7 @@ export class RealtimeLoop {
       if (this.stopped) return;
       const now = clock.now();
       const remaining = this.nextDeadline() - now;
-      if (this.eventLoop && remaining > COARSE_S && typeof Atomics.waitAsync === "function") {
-        // Sleep in the event loop so that I/O callbacks run as soon as data arrives.
-        const seen = Atomics.load(doorbell, BELL_WAKE);
-        const r = Atomics.waitAsync(doorbell, BELL_WAKE, seen, (remaining - COARSE_S) * 1000);
-        if (r.async) r.value.then(this.turn, this.turn);
-        else this.o.yieldNow(this.turn);
-        return;
-      }
-      if (
-        Atomics.load(doorbell, BELL_CONTROL) !== 0 ||
-        now - this.lastYield >= (this.eventLoop ? 0 : YIELD_S)
-      ) {
+      if (Atomics.load(doorbell, BELL_CONTROL) !== 0 || now - this.lastYield >= YIELD_S) {
         this.o.yieldNow(this.turn);
         if (remaining > 0.0005) return;
         // A deadline is imminent: wait for it first, the event loop turns right after.
@@ -131,6 +129,41 @@ export class RealtimeLoop {
       this.sleepUntilDeadline(MAX_BLOCK_S);
     }
   };
+
+  /**
+   * A turn of a worker with I/O blocks: step, then sleep in the event loop (so that I/O callbacks
+   * run as soon as data arrives) until the learned overshoot before the next target, and block
+   * only for that last bit.
+   */
+  private ioTurn(): void {
+    const { clock, doorbell } = this.o;
+    Atomics.store(doorbell, BELL_CONTROL, 0);
+    this.step();
+    if (this.stopped) return;
+    const target = this.nextDeadline();
+    const asyncMargin = Math.min(MAX_ASYNC_MARGIN_S, this.asyncOvershoot + 0.00005);
+    const remaining = target - clock.now();
+    if (remaining <= asyncMargin) {
+      if (remaining > 0) this.sleepUntilDeadline(MAX_ASYNC_MARGIN_S);
+      this.o.yieldNow(this.turn);
+      return;
+    }
+    const seen = Atomics.load(doorbell, BELL_WAKE);
+    const sleepS = Math.min(remaining - asyncMargin, YIELD_S);
+    const r = Atomics.waitAsync(doorbell, BELL_WAKE, seen, sleepS * 1000);
+    if (!r.async) {
+      this.o.yieldNow(this.turn);
+      return;
+    }
+    const wantAt = clock.now() + sleepS;
+    void r.value.then((how) => {
+      if (how === "timed-out" && sleepS < YIELD_S) {
+        const over = clock.now() - wantAt;
+        if (over >= 0 && over < 0.005) this.asyncOvershoot += 0.05 * (over - this.asyncOvershoot);
+      }
+      this.turn();
+    }, this.turn);
+  }
 
   /** Blocks until just before the next deadline (at most `maxS`) or until the doorbell rings. */
   private sleepUntilDeadline(maxS: number): void {

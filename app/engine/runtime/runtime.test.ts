@@ -255,51 +255,138 @@ C: { Type: Counter, Inputs: [T], Params: { Channels: 2, Scale: 0.1 }, Path: out/
   });
 });
 
+describe("batching", () => {
+  const pipeline = (ms: number) => `
+Pipeline: { BatchingMs: ${ms} }
+T: { Type: Tick, DesiredRate: 1000 }
+C: { Type: Counter, Inputs: [T], Params: { Channels: 2 } }
+S: { Type: Tick, DesiredRate: 25, BatchingMs: 0 }
+`;
+
+  test("virtual time wakes as a batching real-time worker would: same events, fewer frames", async () => {
+    const one = await runVirtualPipeline(pipeline(0), { catalog, duration: 1 });
+    const five = await runVirtualPipeline(pipeline(5), { catalog, duration: 1 });
+    const c1 = one.outputs.get("C")!;
+    const c5 = five.outputs.get("C")!;
+    expect(c1.t).toHaveLength(1001);
+    expect(c5.t).toEqual(c1.t);
+    expect(c5.v).toEqual(c1.v);
+    expect(Math.max(...c1.frames)).toBe(1);
+    // 5 ms at 1 kHz: the 6 ticks within the interval go out together (a 25 Hz wake-up may split a batch).
+    expect(Math.max(...c5.frames)).toBe(6);
+    expect(c5.frames.length).toBeLessThan(c1.frames.length / 4);
+    // The block's own BatchingMs: the 25 Hz timer fires alone, one tick per frame.
+    expect(Math.max(...five.outputs.get("S")!.frames)).toBe(1);
+    // Timestamps stay the exact deadlines: k / 1000.
+    c5.t.forEach((t, k) => expect(t).toBe(k / 1000));
+  });
+
+  test("telemetry reports each timer's batching and catch-up policy", async () => {
+    const run = await runVirtualPipeline(pipeline(3), { catalog, duration: 0.1 });
+    const timer = (name: string) => run.telemetry.blocks.find((b) => b.name === name)!.timer!;
+    expect(timer("T").batchingMs).toBe(3);
+    expect(timer("S").batchingMs).toBe(0);
+    expect(timer("T").catchUp).toBe("all");
+  });
+});
+
 describe("scheduler", () => {
-  test("skips and counts missed ticks instead of bursting", () => {
+  const collect = (into: number[][]) => (times: Float64Array, n: number) =>
+    into.push(Array.from(times.subarray(0, n)));
+  const fireAll = (s: Scheduler, now: number) =>
+    s.fireDue(now, (x, n) => (x.period > 0 ? x.onTicks(x.times, n) : x.cb(x.times[0]!)));
+
+  test("lossless: after a stall every due tick goes out in one call, stamped with its deadline", () => {
     const s = new Scheduler(false);
-    const fired: number[] = [];
-    const e = s.add("t", 0.01, (t) => fired.push(t));
+    const calls: number[][] = [];
+    const e = s.addPeriodic("t", 100, collect(calls));
     s.start(e, 100);
-    s.fireDue(100, (x, t) => x.cb(t));
-    // The worker was blocked for 35 ms: one tick fires now, three are skipped.
-    s.fireDue(100.035, (x, t) => x.cb(t));
-    expect(fired).toEqual([100, 100.035]);
-    expect(e.missed).toBe(2);
+    fireAll(s, 100);
+    // The worker was blocked for 35 ms: the three ticks due since go out together.
+    expect(fireAll(s, 100.035)).toBe(1);
+    expect(calls.length).toBe(2);
+    expect(calls[0]).toEqual([100]);
+    expect(calls[1]!.length).toBe(3);
+    calls[1]!.forEach((t, i) => expect(t).toBe(100 + (i + 1) * 0.01));
+    expect(e.missed).toBe(0);
+    expect(e.fired).toBe(4);
     expect(e.next).toBeCloseTo(100.04, 12);
+    // Lateness is measured against the newest deadline fired.
     expect(e.lateness!.count).toBe(2);
     expect(e.lateness!.quantile(1)).toBe(5000);
+  });
+
+  test("catchUp skip: only the newest due tick goes out, the others are counted as missed", () => {
+    const s = new Scheduler(false);
+    const calls: number[][] = [];
+    const e = s.addPeriodic("t", 100, collect(calls), { catchUp: "skip", batchS: 0.05 });
+    s.start(e, 100);
+    fireAll(s, 100);
+    fireAll(s, 100.035);
+    expect(calls).toEqual([[100], [100.03]]);
+    expect(e.missed).toBe(2);
+    // A skipping timer never waits to batch.
+    expect(s.nextWake()).toBe(e.next);
+  });
+
+  test("batching: the wake-up waits for the last tick within the interval, then fires them all", () => {
+    const s = new Scheduler(false);
+    const calls: number[][] = [];
+    const e = s.addPeriodic("t", 2000, collect(calls), { batchS: 0.002 });
+    s.start(e, 10);
+    expect(s.nextWake()).toBe(10 + 4 / 2000);
+    fireAll(s, s.nextWake());
+    expect(calls).toEqual([[10, 10.0005, 10.001, 10.0015, 10.002]]);
+    expect(s.nextWake()).toBeCloseTo(10 + 9 / 2000, 12);
+    // A period longer than the interval: a wake-up per tick.
+    const slow = s.addPeriodic("slow", 200, () => {}, { batchS: 0.002 });
+    s.start(slow, 10);
+    expect(s.nextWake()).toBe(10);
+  });
+
+  test("a very long stall is delivered in bounded calls, nothing lost", () => {
+    const s = new Scheduler(false);
+    let total = 0;
+    let largest = 0;
+    const e = s.addPeriodic("t", 10000, (_t, n) => {
+      total += n;
+      largest = Math.max(largest, n);
+    });
+    s.start(e, 0);
+    fireAll(s, 20); // 200 001 ticks due
+    expect(total).toBe(200_001);
+    expect(largest).toBe(65536);
   });
 
   test("an entry fired slightly early is stamped with its deadline; re-arming in the past cannot hang", () => {
     const s = new Scheduler(false);
     s.earlyTolerance = 0.0001;
     const stamps: number[] = [];
-    const e = s.add("once", 0, (t) => stamps.push(t));
+    const e = s.addOneShot("once", (t) => stamps.push(t));
     s.once(e, 10.00005);
-    s.fireDue(10, (x, t) => x.cb(t));
+    fireAll(s, 10);
     expect(stamps).toEqual([10.00005]);
     // A callback that always asks to run again at a time already due must not loop forever.
-    const loop = s.add("loop", 0, () => s.once(loop, 5));
+    const loop = s.addOneShot("loop", () => s.once(loop, 5));
     s.once(loop, 5);
-    expect(s.fireDue(10, (x, t) => x.cb(t))).toBe(100_000);
+    expect(fireAll(s, 10)).toBe(100_000);
   });
 
   test("deadlines are base + k/rate (no drift) and fire in deadline order", () => {
     const s = new Scheduler(true);
     const order: string[] = [];
-    const a = s.add("a", 0.1, () => order.push("a"));
-    const b = s.add("b", 0.25, () => order.push("b"));
+    const a = s.addPeriodic("a", 10, () => order.push("a"));
+    const b = s.addPeriodic("b", 4, () => order.push("b"));
     s.start(a, 0);
     s.start(b, 0);
     let t = 0;
     for (let i = 0; i < 12; i++) {
       t = s.nextDeadline();
-      s.fireDue(t, (x, tt) => x.cb(tt));
+      fireAll(s, t);
     }
     // 0: a b, .1 a, .2 a, .25 b, .3 a, .4 a, .5 a b, .6 a, .7 a, .75 b, .8 a, .9 a
     expect(order.join("")).toBe("abaabaaabaabaa");
-    expect(a.next).toBeCloseTo(0.1 * a.k, 15);
+    expect(a.next).toBe(a.k / 10);
   });
 });
 

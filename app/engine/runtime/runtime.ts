@@ -25,7 +25,7 @@ import type { IoBridges } from "../io";
 import { Deque } from "./deque";
 import type { LogChannel, LogSink } from "./logsink";
 import type { SabRing } from "./sab-ring";
-import { Scheduler, type TimerEntry } from "./scheduler";
+import { Scheduler, type CatchUp, type TickCallback, type TimerEntry } from "./scheduler";
 import { StatusTracker, type Status } from "./status";
 
 // ---------------------------------------------------------------------------------------------
@@ -47,6 +47,13 @@ export interface BlockTelemetry {
   computeMaxMs: number;
   /** Mean (emission time − event timestamp) since the previous telemetry, ms. */
   latencyMs: number;
+  /**
+   * Delivery delay: time of processing − timestamp of the oldest event of each batch the block
+   * received (timers: of each batch of ticks they fired), ms; p50/p99/max since the start or the
+   * last `resetTiming`, and the largest since the previous telemetry. Real time only (0 under the
+   * virtual clock). `n` counts batches.
+   */
+  delay: { p50Ms: number; p99Ms: number; maxMs: number; windowMaxMs: number; n: number };
   /** Events dropped on the edges into this block (all time). */
   dropsIn: number;
   text: string;
@@ -55,14 +62,19 @@ export interface BlockTelemetry {
   finished: boolean;
   /** Timers only. */
   timer?: {
+    /** Ticks delivered. */
     fired: number;
+    /** Ticks skipped (`CatchUp: skip` only; a lossless timer never misses one). */
     missed: number;
+    catchUp: CatchUp;
+    /** The timer's batching interval, ms. */
+    batchingMs: number;
     latenessP50Us: number;
     latenessP99Us: number;
     latenessMaxUs: number;
     running: boolean;
   };
-  /** ΔT between consecutive outputs (emission clock), since start or the last `resetTiming`. */
+  /** ΔT between consecutive output events (timestamps), since start or the last `resetTiming`. */
   timing: { n: number; meanDt: number; stdDt: number; computeTotalMs: number; calls: number };
 }
 
@@ -117,6 +129,12 @@ export interface Plan {
 // ---------------------------------------------------------------------------------------------
 
 const DEFAULT_QUEUE_MIN = 64;
+/**
+ * The default batching interval (DESIGN.md §3): a worker wakes at most once per interval and
+ * fires every tick due, as devices deliver packets. Measured on the 2-core bench machine
+ * (bench/README.md): 1926 Hz at 0 / 1 / 2 ms …
+ */
+export const DEFAULT_BATCHING_S = 0.002;
 const WARN_INTERVAL_S = 2;
 
 export interface RemoteSender {
@@ -139,6 +157,11 @@ export interface RuntimeOptions {
   plan?: Plan;
   /** Run every block here regardless of its `Worker` key (the virtual clock does this). */
   ignorePlacement?: boolean;
+  /**
+   * The batching interval for blocks that do not set their own (`BatchingMs`), s: overrides the
+   * pipeline's `Pipeline: { BatchingMs }` (the CLI's `--batching-ms`).
+   */
+  batchingS?: number;
 }
 
 class Edge {
@@ -235,6 +258,8 @@ class Node {
   readonly extraLogs: LogChannel[] = [];
   started = false;
   params: unknown;
+  /** The batching interval of this block's timers, s. */
+  readonly batchS: number;
 
   constructor(
     readonly rt: Runtime,
@@ -243,7 +268,9 @@ class Node {
     public desiredRate: number,
     readonly local: boolean,
   ) {
+    this.batchS = spec.batchingMs !== undefined ? spec.batchingMs / 1000 : rt.batchS;
     this.status = new StatusTracker(desiredRate);
+    this.status.batchS = rt.maxBatchS;
     this.params = spec.params;
     this.finite = def.finite?.(spec.params) ?? false;
   }
@@ -315,11 +342,20 @@ export class Runtime {
   private finishedCount = 0;
   /** Called after a block asks for a wake-up (new timer, one-shot) so the host can re-plan its wait. */
   onWake: (() => void) | null = null;
+  /** The batching interval of blocks without their own `BatchingMs`, s. */
+  readonly batchS: number;
+  /** The largest batching interval any block of the pipeline uses, s (status allows for it). */
+  readonly maxBatchS: number;
 
   private constructor(
     readonly spec: PipelineSpec,
     opts: RuntimeOptions,
   ) {
+    this.batchS = opts.batchingS ?? batchingOf(spec);
+    this.maxBatchS = Math.max(
+      this.batchS,
+      ...spec.blocks.map((b) => (b.batchingMs !== undefined ? b.batchingMs / 1000 : 0)),
+    );
     this.worker = opts.worker ?? "main";
     this.clock = opts.clock;
     this.virtual = opts.virtual;
@@ -545,9 +581,15 @@ export class Runtime {
         node.ports.push(p);
         return p;
       },
-      every(hz: number, tick: (t: number) => void): TimerHandle {
+      get batching() {
+        return node.batchS;
+      },
+      every(hz: number, tick: TickCallback, options?: { catchUp?: CatchUp }): TimerHandle {
         if (!(hz > 0)) throw new BlockConfigError(`a timer rate must be positive, got ${hz}`);
-        const e = sched.add(node.name, 1 / hz, tick);
+        const e = sched.addPeriodic(node.name, hz, tick, {
+          batchS: node.batchS,
+          ...(options?.catchUp !== undefined ? { catchUp: options.catchUp } : {}),
+        });
         node.timers.push(e);
         return {
           start() {
@@ -570,15 +612,14 @@ export class Runtime {
           },
           setRate(h: number) {
             if (!(h > 0)) throw new Error(`a timer rate must be positive, got ${h}`);
-            e.period = 1 / h;
-            if (e.running) sched.start(e, rt.clock.now());
+            sched.setRate(e, h, rt.clock.now());
             rt.onWake?.();
           },
         };
       },
       at(t: number, fn: (t: number) => void) {
         if (!node.oneShot) {
-          node.oneShot = sched.add(node.name, 0, fn);
+          node.oneShot = sched.addOneShot(node.name, fn);
         }
         node.oneShot.cb = fn;
         sched.once(node.oneShot, t);
@@ -680,8 +721,28 @@ export class Runtime {
     }
   }
 
-  /** Delivers queued frames until the FIFO is empty. */
+  /** Delivers queued frames until the FIFO is empty, then lets holding blocks flush (and so on). */
   dispatch(): void {
+    do this.drainFifo();
+    while (this.flushHolders());
+  }
+
+  /** Calls `flush` on the blocks that have one; true when that queued new deliveries. */
+  private flushHolders(): boolean {
+    const holders = this.holders;
+    for (let i = 0; i < holders.length; i++) {
+      const node = holders[i]!;
+      if (!node.started) continue;
+      try {
+        node.instance.flush!();
+      } catch (err) {
+        this.fail(node, err);
+      }
+    }
+    return this.fifo.length > 0;
+  }
+
+  private drainFifo(): void {
     const fifo = this.fifo;
     while (fifo.length > 0) {
       const e = fifo.shift()!;
@@ -707,27 +768,31 @@ export class Runtime {
     const proc = node.instance.process;
     if (!proc || !node.started) return;
     const t0 = performance.now();
+    // A batch is as late as its oldest event.
+    if (!this.virtual) node.status.delivered(f.t[0]!, this.clock.now());
     try {
       proc.call(node.instance, f, port);
     } catch (err) {
       this.fail(node, err);
     }
     const now = this.clock.now();
-    node.status.compute(performance.now() - t0, now);
+    node.status.compute(performance.now() - t0, now, f.n);
     // A block without outputs (a sink, a device output) is timed by what it consumes.
     if (node.ports.length === 0) node.status.record(f, now);
   }
 
-  private fireEntry = (e: TimerEntry, t: number): void => {
+  private fireEntry = (e: TimerEntry, n: number): void => {
     const node = this.byName.get(e.owner);
     if (!node || !node.started) return;
     const t0 = performance.now();
+    if (e.period > 0 && !this.virtual) node.status.delivered(e.times[0]!, this.clock.now());
     try {
-      e.cb(t);
+      if (e.period > 0) e.onTicks(e.times, n);
+      else e.cb(e.times[0]!);
     } catch (err) {
       this.fail(node, err);
     }
-    node.status.compute(performance.now() - t0, this.clock.now());
+    node.status.compute(performance.now() - t0, this.clock.now(), n);
   };
 
   /** Fires every timer due at `now` (then call `dispatch`). */
@@ -751,6 +816,8 @@ export class Runtime {
   private stepping = false;
 
   private readonly inbound: Edge[] = [];
+  /** Blocks with a `flush` (called when a step has delivered everything). */
+  private holders: Node[] = [];
 
   /** Sends what `block`'s output `port` emits into a cross-worker ring too. */
   attachRemoteOut(block: string, port: string, sender: RemoteSender): void {
@@ -784,8 +851,9 @@ export class Runtime {
     }
   }
 
+  /** When the worker should wake next (the scheduler's batching applied). */
   nextDeadline(): number {
-    return this.scheduler.nextDeadline();
+    return this.scheduler.nextWake();
   }
 
   get pending(): number {
@@ -830,6 +898,7 @@ export class Runtime {
   start(): void {
     if (this.running) return;
     this.running = true;
+    this.holders = this.nodes.filter((n) => typeof n.instance.flush === "function");
     this.startTime = this.clock.now();
     for (const n of this.nodes) n.started = true;
     for (const n of this.nodes) {
@@ -995,6 +1064,7 @@ export class Runtime {
         computeMeanMs: s.callsWindow ? s.computeSumWindow / s.callsWindow : 0,
         computeMaxMs: s.computeMaxWindow,
         latencyMs: s.latencyN ? (s.latencySum / s.latencyN) * 1000 : 0,
+        delay: delayFigures(s),
         dropsIn,
         text: n.text,
         errors: n.errors,
@@ -1013,6 +1083,8 @@ export class Runtime {
         bt.timer = {
           fired: timer.fired,
           missed: timer.missed,
+          catchUp: timer.catchUp,
+          batchingMs: timer.batchS * 1000,
           latenessP50Us: h ? h.quantile(0.5) : 0,
           latenessP99Us: h ? h.quantile(0.99) : 0,
           latenessMaxUs: h && h.count ? h.maxUs : 0,
@@ -1037,4 +1109,23 @@ export class Runtime {
     const events = this.events.splice(0, this.events.length);
     return { t: now, worker: this.worker, blocks, edges, events, finished: this.finished };
   }
+}
+
+/** The pipeline's own batching interval (`Pipeline: { BatchingMs }`), or the default, s. */
+export function batchingOf(spec: PipelineSpec): number {
+  return spec.settings.batchingMs !== undefined
+    ? spec.settings.batchingMs / 1000
+    : DEFAULT_BATCHING_S;
+}
+
+function delayFigures(s: StatusTracker): BlockTelemetry["delay"] {
+  const h = s.delay;
+  const ms = (x: number): number => (Number.isFinite(x) ? x * 1000 : 0);
+  return {
+    p50Ms: ms(h.quantile(0.5)),
+    p99Ms: ms(h.quantile(0.99)),
+    maxMs: ms(h.max),
+    windowMaxMs: ms(s.delayMaxWindow),
+    n: h.count,
+  };
 }

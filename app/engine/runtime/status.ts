@@ -1,13 +1,22 @@
 /**
- * Timing status exactly as DESIGN.md §3 / the paper III-B:
+ * Timing status as DESIGN.md §3 / the paper III-B, for a runtime that delivers events in batches:
  * - rate = (n − 1) / (t_last − t_first) over the last 100 outputs (event timestamps);
- * - idle (grey) when there was no output for 10 periods (or none at all);
- * - lagging (red) when rate < 95 % of DesiredRate;
- * - stumbling (magenta) when one `process` call (measured) took longer than 1 / DesiredRate
- *   within the current 100-output window;
+ * - idle (grey) when there was no output for 10 periods (plus the batching interval, during
+ *   which a batch is allowed to wait), or none at all;
+ * - lagging (red) when rate < 95 % of DesiredRate, or when, within the current 100-output
+ *   window, an input batch reached the block late: its oldest event waited longer than
+ *   max(2 periods, 20 ms) plus the batching interval (the engine is behind real time; lossless
+ *   timers keep rates exact, so a rate alone would not show it);
+ * - stumbling (magenta) when one `process` call (measured) took longer than the time its events
+ *   span, max(1, n) / DesiredRate, within the current window;
  * - on time (green) otherwise. Precedence idle > lagging > stumbling > on time.
+ *
+ * Delivery delay (processing time − timestamp of the oldest event of a batch) is kept in a
+ * histogram since the last `resetTiming` (p50 / p99 / max in telemetry) and as a per-telemetry
+ * window maximum.
  */
 import type { Frame } from "../frame";
+import { DelayHistogram } from "./delay-histogram";
 
 export type Status = "idle" | "lagging" | "stumbling" | "ontime";
 export const STATUSES: readonly Status[] = ["ontime", "idle", "lagging", "stumbling"];
@@ -17,6 +26,10 @@ export const LAG_FRACTION = 0.95;
 export const IDLE_PERIODS = 10;
 /** Idle threshold for blocks without a desired rate (aperiodic, e.g. triggers). */
 export const APERIODIC_IDLE_S = 1;
+/** A batch is late when its oldest event waited longer than this many periods … */
+export const LATE_PERIODS = 2;
+/** … or this long, whichever is more, plus the batching interval. */
+export const LATE_MIN_S = 0.02;
 
 export interface StatusEval {
   status: Status;
@@ -36,6 +49,14 @@ export class StatusTracker {
   events = 0;
   lastWall = -Infinity;
   lastOverrunWall = -Infinity;
+  lastLateWall = -Infinity;
+  /** The batching interval that applies to this block's inputs, s (set by the runtime). */
+  batchS = 0;
+
+  /** Delivery delay since the last `resetTiming` (real time only). */
+  readonly delay = new DelayHistogram();
+  /** Largest delivery delay since the last telemetry, s. */
+  delayMaxWindow = 0;
 
   // compute time of `process` calls (ms)
   calls = 0;
@@ -49,11 +70,11 @@ export class StatusTracker {
   latencySum = 0;
   latencyN = 0;
 
-  // ΔT between consecutive outputs, by emission clock time (Welford), for the bench's Table 5
+  // ΔT between consecutive output events, by event timestamps (Welford), for the bench's Table 5
   dtN = 0;
   dtMean = 0;
   dtM2 = 0;
-  private prevWall = NaN;
+  private prevT = NaN;
 
   constructor(public desiredRate: number) {}
 
@@ -62,9 +83,9 @@ export class StatusTracker {
     const n = f.n;
     const rate = this.desiredRate;
     // Back from idle: the window restarts, so a pause does not read as lagging afterwards.
-    if (rate > 0 && now - this.lastWall > IDLE_PERIODS / rate) {
+    if (rate > 0 && now - this.lastWall > IDLE_PERIODS / rate + this.batchS) {
       this.inWindow = 0;
-      this.prevWall = NaN;
+      this.prevT = NaN;
     }
     const t = f.t;
     const start = n > RATE_WINDOW ? n - RATE_WINDOW : 0;
@@ -78,28 +99,50 @@ export class StatusTracker {
     this.lastWall = now;
     this.latencySum += now - t[n - 1]!;
     this.latencyN++;
-    // ΔT stats: the first event of the frame against the previous output, then 0 within a batch.
+    // ΔT stats between consecutive events by their timestamps (how regular the data is; how
+    // late it was processed is the delivery delay).
+    let prev = this.prevT;
     for (let i = 0; i < n; i++) {
-      if (this.prevWall === this.prevWall) {
-        const dt = now - this.prevWall;
+      const ti = t[i]!;
+      if (prev === prev) {
+        const dt = ti - prev;
         this.dtN++;
         const d = dt - this.dtMean;
         this.dtMean += d / this.dtN;
         this.dtM2 += d * (dt - this.dtMean);
       }
-      this.prevWall = now;
+      prev = ti;
     }
+    this.prevT = prev;
   }
 
-  /** Records one measured `process` (or timer callback) call of `ms` milliseconds. */
-  compute(ms: number, now: number): void {
+  /**
+   * Records the delivery delay of a batch at clock time `now`: `now − oldest`, where `oldest` is
+   * the timestamp of its oldest event.
+   */
+  delivered(oldest: number, now: number): void {
+    const d = now - oldest;
+    this.delay.add(d);
+    if (d > this.delayMaxWindow) this.delayMaxWindow = d;
+    const r = this.desiredRate;
+    const late = Math.max(r > 0 ? LATE_PERIODS / r : 0, LATE_MIN_S) + this.batchS;
+    if (d > late) this.lastLateWall = now;
+  }
+
+  /**
+   * Records one measured `process` (or timer callback) call of `ms` milliseconds that handled
+   * `events` events (a call may take as long as the time they span).
+   */
+  compute(ms: number, now: number, events = 1): void {
     this.calls++;
     this.callsWindow++;
     this.computeLast = ms;
     this.computeSumWindow += ms;
     this.computeTotal += ms;
     if (ms > this.computeMaxWindow) this.computeMaxWindow = ms;
-    if (this.desiredRate > 0 && ms > 1000 / this.desiredRate) this.lastOverrunWall = now;
+    if (this.desiredRate > 0 && ms > (1000 * Math.max(1, events)) / this.desiredRate) {
+      this.lastOverrunWall = now;
+    }
   }
 
   /**
@@ -128,7 +171,7 @@ export class StatusTracker {
   evaluate(now: number): StatusEval {
     const rate = this.rate();
     const d = this.desiredRate;
-    const idleAfter = d > 0 ? IDLE_PERIODS / d : APERIODIC_IDLE_S;
+    const idleAfter = (d > 0 ? IDLE_PERIODS / d : APERIODIC_IDLE_S) + this.batchS;
     if (this.events === 0 || now - this.lastWall > idleAfter) {
       return {
         status: "idle",
@@ -137,9 +180,10 @@ export class StatusTracker {
         stumbling: false,
       };
     }
-    const lagging = d > 0 && rate === rate && rate < LAG_FRACTION * d;
     const n = this.inWindow;
     const windowStart = n > 0 ? this.wall[(this.idx - n + RATE_WINDOW) % RATE_WINDOW]! : now;
+    const slow = d > 0 && rate === rate && rate < LAG_FRACTION * d;
+    const lagging = slow || this.lastLateWall >= windowStart;
     const stumbling = d > 0 && this.lastOverrunWall >= windowStart;
     const status: Status = lagging ? "lagging" : stumbling ? "stumbling" : "ontime";
     return { status, rate, lagging, stumbling };
@@ -152,14 +196,16 @@ export class StatusTracker {
     this.callsWindow = 0;
     this.latencySum = 0;
     this.latencyN = 0;
+    this.delayMaxWindow = 0;
   }
 
-  /** Resets the ΔT statistics (e.g. after a bench warm-up). */
+  /** Resets the ΔT and delivery-delay statistics (e.g. after a bench warm-up). */
   resetTiming(): void {
     this.dtN = 0;
     this.dtMean = 0;
     this.dtM2 = 0;
-    this.prevWall = NaN;
+    this.prevT = NaN;
+    this.delay.reset();
     this.computeTotal = 0;
     this.calls = 0;
   }
