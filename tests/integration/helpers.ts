@@ -29,6 +29,8 @@ export function runCli(args: string[], opts: { cwd?: string; timeoutMs?: number 
     cwd: opts.cwd ?? ROOT,
     encoding: "utf8",
     timeout: opts.timeoutMs ?? 60_000,
+    // `run --json` prints 20 telemetry lines a second: a run of a few seconds passes Node's 1 MiB.
+    maxBuffer: 256 * 1024 * 1024,
     env: { ...process.env, NO_COLOR: "1" },
   });
   return { code: r.status, stdout: r.stdout, stderr: r.stderr };
