@@ -160,12 +160,22 @@ async function cmdFormat(args: string[]): Promise<number> {
 
 function summaryLines(t: Telemetry): string[] {
   const lines: string[] = [];
+  const ms = (x: number): string => (x < 1 ? x.toFixed(3) : x.toFixed(2));
   for (const b of t.blocks) {
     if (b.timer && b.timer.fired > 0 && b.timer.latenessP50Us === b.timer.latenessP50Us) {
+      const missed =
+        b.timer.catchUp === "skip" ? `${b.timer.missed} skipped (CatchUp: skip)` : "none lost";
       lines.push(
-        `${b.name}: ${b.timer.fired} ticks, ${b.timer.missed} missed, lateness p50 ${b.timer.latenessP50Us} µs, p99 ${b.timer.latenessP99Us} µs, max ${Math.round(b.timer.latenessMaxUs)} µs`,
+        `${b.name}: ${b.timer.fired} ticks (${missed}), batching ${b.timer.batchingMs} ms, wake-up lateness p50 ${b.timer.latenessP50Us} µs, p99 ${b.timer.latenessP99Us} µs, max ${Math.round(b.timer.latenessMaxUs)} µs`,
       );
     }
+  }
+  const delayed = t.blocks.filter((b) => b.delay.n > 0);
+  if (delayed.length > 0) {
+    const worst = delayed.reduce((a, b) => (b.delay.p99Ms > a.delay.p99Ms ? b : a));
+    lines.push(
+      `delivery delay (processing − event time): worst p99 ${ms(worst.delay.p99Ms)} ms (${worst.name}), max ${ms(Math.max(...delayed.map((b) => b.delay.maxMs)))} ms`,
+    );
   }
   return lines;
 }

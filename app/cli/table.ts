@@ -1,4 +1,7 @@
-/** The live per-block table of `mosaic run` (name, type, rates, status, compute time, drops). */
+/**
+ * The live per-block table of `mosaic run` (name, type, rates, status, compute time, delivery
+ * delay, drops).
+ */
 import type { Status } from "../engine/runtime/status";
 import type { Telemetry } from "../engine/runtime/runtime";
 
@@ -54,6 +57,7 @@ export function renderTable(t: Telemetry, o: TableOptions): string[] {
     "actual Hz",
     "status",
     "compute (mean / max)",
+    "delay (p99 / max)",
     "drops",
     "",
   ];
@@ -64,6 +68,7 @@ export function renderTable(t: Telemetry, o: TableOptions): string[] {
     fmtRate(b.rate),
     statusLabel(b.status, b.stumbling),
     `${fmtMs(b.computeMeanMs)} / ${fmtMs(b.computeMaxMs)}`,
+    b.delay.n > 0 ? `${fmtMs(b.delay.p99Ms)} / ${fmtMs(b.delay.maxMs)}` : "-",
     String(b.dropsIn),
     [
       b.errors > 0 ? `error: ${b.lastError}${b.errors > 1 ? ` (×${b.errors})` : ""}` : "",
@@ -76,7 +81,7 @@ export function renderTable(t: Telemetry, o: TableOptions): string[] {
   const widths = header.map((h, i) =>
     Math.max([...h].length, ...rows.map((r) => [...r[i]!].length)),
   );
-  const right = [false, false, true, true, false, true, true, false];
+  const right = [false, false, true, true, false, true, true, true, false];
   const line = (cells: string[], status?: Status): string => {
     const padded = cells.map((c, i) => pad(c, widths[i]!, right[i]));
     const plain = padded.join("  ").trimEnd();
