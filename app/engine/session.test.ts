@@ -3,7 +3,8 @@ import { VirtualClock } from "./clock";
 import type { DataMessage, EngineMessage } from "./protocol";
 import type { Runtime } from "./runtime/runtime";
 import { runVirtual } from "./runtime/virtual";
-import { EngineSession, type LoopHooks, type SessionPlatform } from "./session";
+import { Frame } from "./frame";
+import { EngineSession, Watch, type LoopHooks, type SessionPlatform } from "./session";
 import { testCatalog } from "./test-blocks";
 import { noResources } from "./testing";
 
@@ -177,5 +178,81 @@ describe("EngineSession", () => {
     // Works without a pipeline, and again (cached).
     await s.handle({ type: "catalog", id: 2 });
     expect(replies(f.sent)[1]).toMatchObject({ id: 2, ok: true });
+  });
+});
+
+/** A frame of `n` events of `cols` channels: times from `t0` at `rate`, values event·100 + col. */
+function frameOf(n: number, cols: number, first: number, rate: number, rows = 1): Frame {
+  const f = new Frame({ rows, cols }, n);
+  f.n = n;
+  for (let i = 0; i < n; i++) {
+    f.t[i] = 1000 + (first + i) / rate;
+    for (let k = 0; k < rows * cols; k++) f.v[i * rows * cols + k] = (first + i) * 100 + k;
+  }
+  return f;
+}
+
+describe("Watch (panel data on the hot path)", () => {
+  test("keeps every n-th event across frames of any size, the phase carried over", () => {
+    const w = new Watch("B", "out", 1, 2, 1000, 100);
+    expect(w.every).toBe(10);
+    let first = 0;
+    for (const n of [3, 1, 7, 10, 25, 4, 2, 48]) {
+      w.add(frameOf(n, 2, first, 1000));
+      first += n;
+    }
+    const m = w.take()!;
+    const idx = [...m.t].map((t) => Math.round((t - 1000) * 1000));
+    expect(idx).toEqual([0, 10, 20, 30, 40, 50, 60, 70, 80, 90]);
+    expect([...m.v.subarray(0, 4)]).toEqual([0, 1, 1000, 1001]);
+    expect(m.skipped).toBe(first - 10);
+    expect(w.take()).toBeNull();
+  });
+
+  test("an output slower than maxRate goes whole; one flush carries at most its capacity, the newest", () => {
+    const w = new Watch("B", "out", 2, 3, 50, 100);
+    expect(w.every).toBe(1);
+    const cap = w.capacity;
+    expect(cap).toBe(Math.ceil(100 * 0.25) + 8);
+    let first = 0;
+    // More than the rings hold before a flush: the oldest make room, counted as skipped.
+    while (first < cap + 13) {
+      w.add(frameOf(4, 3, first, 50, 2));
+      first += 4;
+    }
+    expect(w.held).toBe(cap);
+    const m = w.take()!;
+    expect(m).toMatchObject({ rows: 2, cols: 3, skipped: first - cap });
+    expect(m.t.length).toBe(cap);
+    expect(m.v.length).toBe(cap * 6);
+    // In time order, ending with the newest event, values intact across the ring's wrap.
+    for (let e = 0; e < cap; e++) {
+      const ev = first - cap + e;
+      expect(Math.round((m.t[e]! - 1000) * 50)).toBe(ev);
+      expect(m.v[e * 6]).toBe(ev * 100);
+      expect(m.v[e * 6 + 5]).toBe(ev * 100 + 5);
+    }
+    // The next flush starts empty and the rings keep working after the wrap.
+    w.add(frameOf(2, 3, first, 50, 2));
+    const m2 = w.take()!;
+    expect(m2.t.length).toBe(2);
+    expect(m2.skipped).toBe(0);
+    expect(m2.v[0]).toBe(first * 100);
+  });
+
+  test("a frame larger than the rings keeps its newest events", () => {
+    const w = new Watch("B", "out", 1, 1, 0, 20);
+    const cap = w.capacity;
+    w.add(frameOf(cap * 3, 1, 0, 1000));
+    const m = w.take()!;
+    expect(m.t.length).toBe(cap);
+    expect(m.v[0]).toBe(cap * 2 * 100);
+    expect(m.skipped).toBe(cap * 2);
+  });
+
+  test("the rings are bounded in memory whatever the rate and the shape", () => {
+    const w = new Watch("H", "out", 64, 256, 2000, 100_000);
+    expect(w.capacity * w.stride).toBeLessThanOrEqual(1 << 20);
+    expect(w.capacity).toBeGreaterThanOrEqual(2);
   });
 });

@@ -15,6 +15,7 @@ import {
   parseUiMessage,
   type BlockInfo,
   type CatalogInfo,
+  type DataMessage,
   type EngineMessage,
   type EngineState,
   type GraphInfo,
@@ -65,14 +66,33 @@ const BUILT_IN_ACTIONS = [
   },
 ];
 
-/** Panel data of one watched output: decimated to `maxRate`, flushed with the telemetry. */
-class Watch {
-  t = new Float64Array(64);
-  v: Float64Array;
-  n = 0;
-  skipped = 0;
-  private every = 1;
-  private count = 0;
+/** Seconds of panel data one flush may carry (telemetry flushes every 50 ms). */
+const WATCH_HOLD_S = 0.25;
+/** Values one watch may hold, whatever its rate and shape (8 MiB). */
+const WATCH_MAX_VALUES = 1 << 20;
+
+/**
+ * Panel data of one watched output. `add` runs on the engine's hot path (a tap inside `emit`),
+ * so it does as little as possible: it keeps every `every`-th event (at most `maxRate` events
+ * per second, from the block's desired rate; all of them when the rate is not known), finds the
+ * kept ones by arithmetic instead of visiting every event, and copies their values into rings
+ * allocated once: no allocation, no work for the events left out. The rings hold what one flush
+ * may carry (`maxRate` for WATCH_HOLD_S): when a flush comes late, the oldest kept events make
+ * room for the newest and count as skipped. Packing and posting (`take`) happen at telemetry
+ * time, off the hot path.
+ */
+export class Watch {
+  private readonly t: Float64Array;
+  private readonly v: Float64Array;
+  /** Capacity of the rings, events. */
+  readonly capacity: number;
+  /** Next event to write (ring index) and events held. */
+  private head = 0;
+  private n = 0;
+  private skipped = 0;
+  /** Events to leave out before the next kept one. */
+  private gap = 0;
+  readonly every: number;
   readonly stride: number;
   untap: () => void = () => {};
 
@@ -85,43 +105,97 @@ class Watch {
     maxRate: number,
   ) {
     this.stride = rows * cols;
-    this.v = new Float64Array(64 * this.stride);
     this.every = rate > maxRate ? Math.ceil(rate / maxRate) : 1;
+    const wanted = Math.ceil(maxRate * WATCH_HOLD_S) + 8;
+    this.capacity = Math.max(
+      2,
+      Math.min(wanted, Math.floor(WATCH_MAX_VALUES / Math.max(1, this.stride))),
+    );
+    this.t = new Float64Array(this.capacity);
+    this.v = new Float64Array(this.capacity * this.stride);
+  }
+
+  /** Events held for the next flush. */
+  get held(): number {
+    return this.n;
   }
 
   add(f: Frame): void {
-    for (let i = 0; i < f.n; i++) {
-      if (this.count++ % this.every !== 0) {
-        this.skipped++;
-        continue;
-      }
-      if (this.n === this.t.length) {
-        const t = new Float64Array(this.t.length * 2);
-        t.set(this.t);
-        this.t = t;
-        const v = new Float64Array(this.v.length * 2);
-        v.set(this.v);
-        this.v = v;
-      }
-      this.t[this.n] = f.t[i]!;
-      const s = this.stride;
-      const src = i * s;
-      const dst = this.n * s;
-      for (let k = 0; k < s; k++) this.v[dst + k] = f.v[src + k]!;
-      this.n++;
+    const n = f.n;
+    let i = this.gap;
+    if (i >= n) {
+      // Nothing of this frame is kept (the common case of a fast output).
+      this.gap = i - n;
+      this.skipped += n;
+      return;
     }
+    const every = this.every;
+    if (every === 1) {
+      this.copy(f, 0, n);
+      return;
+    }
+    let kept = 0;
+    for (; i < n; i += every) {
+      this.copy(f, i, 1);
+      kept++;
+    }
+    this.gap = i - n;
+    this.skipped += n - kept;
   }
 
-  take(): EngineMessage | null {
-    if (this.n === 0) return null;
-    const msg: EngineMessage = {
+  /** Copies events [from, from + count) of `f` into the rings (overwriting the oldest). */
+  private copy(f: Frame, from: number, count: number): void {
+    const cap = this.capacity;
+    if (count > cap) {
+      this.skipped += count - cap;
+      from += count - cap;
+      count = cap;
+    }
+    const s = this.stride;
+    const ft = f.t;
+    const fv = f.v;
+    const t = this.t;
+    const v = this.v;
+    let h = this.head;
+    let src = from * s;
+    for (let e = 0; e < count; e++) {
+      t[h] = ft[from + e]!;
+      let dst = h * s;
+      for (let k = 0; k < s; k++) v[dst++] = fv[src++]!;
+      if (++h === cap) h = 0;
+    }
+    this.head = h;
+    const held = this.n + count;
+    if (held > cap) {
+      this.skipped += held - cap;
+      this.n = cap;
+    } else this.n = held;
+  }
+
+  /** The events held since the previous flush, as a data message (null when none). */
+  take(): DataMessage | null {
+    const n = this.n;
+    if (n === 0) return null;
+    const s = this.stride;
+    const cap = this.capacity;
+    const start = (this.head - n + cap) % cap;
+    const first = Math.min(n, cap - start);
+    const t = new Float64Array(n);
+    const v = new Float64Array(n * s);
+    t.set(this.t.subarray(start, start + first));
+    v.set(this.v.subarray(start * s, (start + first) * s));
+    if (first < n) {
+      t.set(this.t.subarray(0, n - first), first);
+      v.set(this.v.subarray(0, (n - first) * s), first * s);
+    }
+    const msg: DataMessage = {
       type: "data",
       block: this.block,
       port: this.port,
       rows: this.rows,
       cols: this.cols,
-      t: this.t.slice(0, this.n),
-      v: this.v.slice(0, this.n * this.stride),
+      t,
+      v,
       skipped: this.skipped,
     };
     this.n = 0;
@@ -412,8 +486,7 @@ export class EngineSession {
     for (const event of events) this.platform.post({ type: "event", event });
     for (const w of this.watches.values()) {
       const m = w.take();
-      if (m && m.type === "data")
-        this.platform.post(m, [m.t.buffer as ArrayBuffer, m.v.buffer as ArrayBuffer]);
+      if (m) this.platform.post(m, [m.t.buffer as ArrayBuffer, m.v.buffer as ArrayBuffer]);
     }
   }
 
