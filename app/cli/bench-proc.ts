@@ -11,6 +11,9 @@
  *   tick quantisation. This is the figure reported when the kernel provides it.
  * Memory: `/proc/<pid>/status` VmRSS every second, and VmHWM (peak RSS) every second and once more
  * when the summary line arrives (the process is still alive then), keeping the last value read.
+ * Wake-ups: `voluntary_ctxt_switches` of every thread (`/proc/<pid>/task/<tid>/status`) at the start
+ * and the end of the steady-state window: a thread that blocks (Atomics.wait, epoll) and is woken
+ * again counts one voluntary switch, so their rate is the thread's wake-ups per second.
  */
 import { spawn } from "node:child_process";
 import { execFileSync } from "node:child_process";
@@ -59,8 +62,17 @@ export interface ChildRun {
   /** Telemetry lines counted in the steady-state window. */
   telemetryLines: number;
   samples: CpuSample[];
-  /** CPU of each thread over the steady-state window (% of one core, busiest first; schedstat). */
-  threads: { tid: number; main: boolean; pct: number }[];
+  /** CPU of each thread over the steady-state window (% of one core, busiest first; schedstat),
+   * with its voluntary (wake-ups) and involuntary (preempted) context switches per second. */
+  threads: {
+    tid: number;
+    main: boolean;
+    pct: number;
+    voluntaryPerS: number;
+    nonvoluntaryPerS: number;
+  }[];
+  /** The steady-state window, performance.now() times in this process (NaN until it started). */
+  windowMs: { from: number; to: number };
   /** Peak RSS (VmHWM) read last, KiB (NaN when never read). */
   peakRssKiB: number;
   /** Seconds from spawn to the summary line minus the run's own wallSeconds: process start,
@@ -145,6 +157,28 @@ function readTaskNs(pid: number): Map<string, number> | undefined {
 export function schedstatAvailable(): boolean {
   const m = readTaskNs(process.pid);
   return m !== undefined && m.size > 0 && [...m.values()].some((v) => v > 0);
+}
+
+/** Voluntary and involuntary context switches of every thread (empty map when unreadable). */
+function readTaskCtxt(pid: number): Map<string, { vol: number; nonvol: number }> {
+  const out = new Map<string, { vol: number; nonvol: number }>();
+  let tids: string[];
+  try {
+    tids = readdirSync(`/proc/${pid}/task`);
+  } catch {
+    return out;
+  }
+  for (const tid of tids) {
+    try {
+      const s = readFileSync(`/proc/${pid}/task/${tid}/status`, "utf8");
+      const vol = /^voluntary_ctxt_switches:\s+(\d+)/m.exec(s);
+      const nonvol = /^nonvoluntary_ctxt_switches:\s+(\d+)/m.exec(s);
+      if (vol && nonvol) out.set(tid, { vol: Number(vol[1]), nonvol: Number(nonvol[1]) });
+    } catch {
+      // the thread exited between readdir and read
+    }
+  }
+  return out;
 }
 
 function readStatusKiB(pid: number, key: "VmRSS" | "VmHWM"): number {
@@ -236,6 +270,7 @@ export function runChild(o: ChildOptions): Promise<ChildRun> {
     telemetryLines: 0,
     samples: [],
     threads: [],
+    windowMs: { from: NaN, to: NaN },
     peakRssKiB: NaN,
     loadSeconds: NaN,
     toSummarySeconds: NaN,
@@ -259,6 +294,8 @@ export function runChild(o: ChildOptions): Promise<ChildRun> {
     let last: CpuMark | undefined = pid !== undefined ? mark(pid, since()) : undefined;
     /** The mark at the start of the steady state (per-thread breakdown). */
     let steadyStart: CpuMark | undefined = o.warmup ? undefined : last;
+    let steadyCtxt = o.warmup || pid === undefined ? undefined : readTaskCtxt(pid);
+    if (!o.warmup) res.windowMs = { from: t0, to: t0 + Math.floor(o.steadySeconds) * 1000 };
     let sampler: NodeJS.Timeout | undefined;
     let summaryAt = NaN;
     let lastTelemetry: Telemetry | undefined;
@@ -289,12 +326,20 @@ export function runChild(o: ChildOptions): Promise<ChildRun> {
         const span = cur.at - steadyStart.at;
         const ns = steadyStart.ns;
         if (span > 0 && ns && cur.ns) {
+          const c0 = steadyCtxt ?? new Map<string, { vol: number; nonvol: number }>();
+          const c1 = readTaskCtxt(pid);
           res.threads = [...cur.ns]
-            .map(([tid, v]) => ({
-              tid: Number(tid),
-              main: Number(tid) === pid,
-              pct: ((v - (ns.get(tid) ?? 0)) / 1e9 / span) * 100,
-            }))
+            .map(([tid, v]) => {
+              const a = c0.get(tid);
+              const b = c1.get(tid);
+              return {
+                tid: Number(tid),
+                main: Number(tid) === pid,
+                pct: ((v - (ns.get(tid) ?? 0)) / 1e9 / span) * 100,
+                voluntaryPerS: b ? (b.vol - (a?.vol ?? 0)) / span : NaN,
+                nonvoluntaryPerS: b ? (b.nonvol - (a?.nonvol ?? 0)) / span : NaN,
+              };
+            })
             .sort((a, b) => b.pct - a.pct);
         }
       }
@@ -351,8 +396,10 @@ export function runChild(o: ChildOptions): Promise<ChildRun> {
           steadyUntil = now + Math.floor(o.steadySeconds);
           if (pid !== undefined) {
             last = steadyStart = mark(pid, now);
+            steadyCtxt = readTaskCtxt(pid);
             startSampler();
           }
+          res.windowMs = { from: t0 + now * 1000, to: t0 + steadyUntil * 1000 };
           if (!res.baseline) res.baseline = lastTelemetry;
           break;
         }
@@ -453,9 +500,20 @@ export function std(xs: readonly number[]): number {
 }
 
 /**
+ * How often a worker wakes for a timer of `hz` ticks per second with a batching interval of
+ * `batchingMs` (DESIGN.md §3): it wakes at the deadline of the last tick within the interval of the
+ * oldest pending one, i.e. once per floor(interval · hz) + 1 ticks.
+ */
+export function wakeRate(hz: number, batchingMs: number): number {
+  if (!(batchingMs > 0)) return hz;
+  return hz / (Math.floor((batchingMs / 1000) * hz + 1e-9) + 1);
+}
+
+/**
  * The cost of waking up alone on this machine: a bare Node worker that does nothing but sleep in
  * `Atomics.wait` until each deadline at `hz` (no engine, no event-loop turns), as % of one core
- * (median of 1-s samples over `seconds`). Pipelines cannot go below this at the same tick rate.
+ * (median of 1-s samples over `seconds`). Pipelines cannot go below this at the same wake-up rate
+ * (`wakeRate`).
  */
 export async function measureWakeFloor(hz: number, seconds: number): Promise<number> {
   const worker =
@@ -484,4 +542,25 @@ export async function measureWakeFloor(hz: number, seconds: number): Promise<num
   } finally {
     child.kill("SIGKILL");
   }
+}
+
+/**
+ * A neighbour that burns one core at normal priority (`node -e "for(;;){}"`), for the loaded
+ * variant of a workload. `stop()` kills it and returns the CPU it used, % of one core over its life
+ * (from /proc/<pid>/stat; NaN when unreadable), so a report shows that it really ran.
+ */
+export function startNeighbour(): { command: string; stop: () => number } {
+  const code = "for(;;){}";
+  const child = spawn(process.execPath, ["-e", code], { stdio: "ignore" });
+  const t0 = performance.now();
+  const pid = child.pid;
+  return {
+    command: `node -e "${code}"`,
+    stop(): number {
+      const ticks = pid !== undefined ? readStatTicks(pid) : NaN;
+      const seconds = (performance.now() - t0) / 1000;
+      child.kill("SIGKILL");
+      return seconds > 0 ? (ticks / clkTck() / seconds) * 100 : NaN;
+    },
+  };
 }

@@ -1,10 +1,16 @@
 import { describe, expect, test } from "vitest";
+import { selects } from "./bench";
 import {
+  batchingMarkdown,
   learnMarkdown,
   pipelineMarkdown,
+  targets,
+  udpRxLine,
+  type BatchingResult,
   type BlockRow,
   type LearnResult,
   type PipelineResult,
+  type UdpRxFigures,
 } from "./bench-report";
 
 const row = (name: string, type: string, rate: number): BlockRow => ({
@@ -18,50 +24,80 @@ const row = (name: string, type: string, rate: number): BlockRow => ({
   computeMeanUs: 2,
   calls: 101,
   dropsIn: 0,
+  delay: { p50Ms: 0.1, p99Ms: 1.5, maxMs: 2.25, n: 100 },
   shares: { ontime: 100, idle: 0, lagging: 0, stumbling: 0 },
 });
 
+function myo(): PipelineResult {
+  return {
+    kind: "pipeline",
+    id: "myo",
+    title: "(a) Myo",
+    paper: "myo",
+    file: "pipelines/bench/myo.yaml",
+    args: ["run", "pipelines/bench/myo.yaml"],
+    ok: true,
+    warmupSeconds: 5,
+    steadySeconds: 30,
+    measuredSeconds: 30.5,
+    cpu: null,
+    blocksComputePct: 0.2,
+    memory: null,
+    // The runtime's creation order: the Stimulus and the decimator come early.
+    blocks: [
+      row("Timer", "ScheduledTimer", 200),
+      row("Decimator", "DecimatorTimer", 25),
+      row("Cues", "Stimulus", 25),
+      row("Myo", "EmgSimulator", 200),
+      row("Amplification", "Function", 200),
+      row("Rectification", "Function", 200),
+      row("LowPass", "Filter", 200),
+      row("Resampler", "Resampler", 25),
+      row("Predictor", "IncrementalPredictor", 25),
+      row("Control", "ControlAlgorithm", 25),
+      row("Sender", "UdpSender", 25),
+    ],
+    timers: [],
+    drops: 0,
+    dropsAllTime: 0,
+    batchingMs: 2,
+    acquisition: "Myo",
+    acquisitionChain: ["Timer", "Myo", "Amplification", "Rectification", "LowPass"],
+    samplesLost: { missedTicks: 0, acquisitionDrops: 0, total: 0 },
+    acquisitionOnTimePct: 100,
+    telemetryLines: 600,
+    loadAvgBefore: [0.1, 0.1, 0.1],
+    loadAvgAfter: [0.1, 0.1, 0.1],
+    loadSeconds: 0.2,
+    lingerSeconds: 0,
+    killedAfterSummary: false,
+    warnings: [],
+  };
+}
+
+const rx: UdpRxFigures = {
+  port: 50512,
+  expectedRateHz: 1926 / 77,
+  windowSeconds: 30,
+  datagrams: 2250,
+  datagramsPerSecond: 75,
+  perEvent: 3,
+  events: 750,
+  rateHz: 25.0125,
+  rateErrorPct: -0.0019,
+  timestampRateHz: 25.01299,
+  expectedDatagrams: 2251,
+  counterGaps: 0,
+  missingEvents: 0,
+  incompleteEvents: 0,
+  maxArrivalGapMs: 44.2,
+  datagramsAll: 2700,
+  malformed: 0,
+};
+
 describe("bench report", () => {
   test("the Myo pipeline's tables follow the paper's row order, extra blocks last", () => {
-    const r: PipelineResult = {
-      kind: "pipeline",
-      id: "myo",
-      title: "(a) Myo",
-      paper: "myo",
-      file: "pipelines/bench/myo.yaml",
-      args: ["run", "pipelines/bench/myo.yaml"],
-      ok: true,
-      warmupSeconds: 5,
-      steadySeconds: 30,
-      measuredSeconds: 30.5,
-      cpu: null,
-      blocksComputePct: 0.2,
-      memory: null,
-      // The runtime's creation order: the Stimulus and the decimator come early.
-      blocks: [
-        row("Timer", "ScheduledTimer", 200),
-        row("Decimator", "DecimatorTimer", 25),
-        row("Cues", "Stimulus", 25),
-        row("Myo", "EmgSimulator", 200),
-        row("Amplification", "Function", 200),
-        row("Rectification", "Function", 200),
-        row("LowPass", "Filter", 200),
-        row("Resampler", "Resampler", 25),
-        row("Predictor", "IncrementalPredictor", 25),
-        row("Control", "ControlAlgorithm", 25),
-        row("Sender", "Sink", 25),
-      ],
-      timers: [],
-      drops: 0,
-      dropsAllTime: 0,
-      telemetryLines: 600,
-      loadAvgBefore: [0.1, 0.1, 0.1],
-      loadAvgAfter: [0.1, 0.1, 0.1],
-      loadSeconds: 0.2,
-      lingerSeconds: 0,
-      killedAfterSummary: false,
-      warnings: [],
-    };
+    const r = myo();
     const md = pipelineMarkdown(r);
     const table5 = md.slice(md.findIndex((l) => l.startsWith("| Block | Type")) + 2);
     const names = table5.slice(0, 11).map((l) => l.split(" | ")[0]!.slice(2));
@@ -78,8 +114,113 @@ describe("bench report", () => {
       "Decimator",
       "Cues",
     ]);
-    expect(table5[7]).toContain("| Control Algorithm | 24.9997 | 0.0004755 |");
+    expect(table5[7]).toContain(
+      "| 2.00 | 0.100 | 1.500 | 2.25 | Control Algorithm | 24.9997 | 0.0004755 |",
+    );
+    expect(table5[8]).toMatch(/^\| Sender \| UdpSender \|.*\| UDP Sender \|/);
     expect(table5[10]).toMatch(/^\| Cues \| Stimulus .*\| - \| - \| - \|$/);
+    expect(md.join("\n")).toContain("Samples lost after the warm-up: **0**");
+  });
+
+  test("the Sender's datagrams, the loaded run and the delay rows reach the targets table", () => {
+    const delsys: PipelineResult = {
+      ...myo(),
+      id: "delsys",
+      acquisition: "Delsys",
+      blocks: [
+        {
+          ...row("Delsys", "EmgSimulator", 1926),
+          delay: { p50Ms: 1.6, p99Ms: 2.9, maxMs: 4, n: 9 },
+        },
+        { ...row("Sender", "UdpSender", 25), delay: { p50Ms: 1.1, p99Ms: 3.2, maxMs: 4, n: 9 } },
+      ],
+      udp: rx,
+    };
+    const loaded: PipelineResult = {
+      ...delsys,
+      id: "delsys-loaded",
+      neighbour: { command: 'node -e "for(;;){}"', cpuPct: 98 },
+      samplesLost: { missedTicks: 0, acquisitionDrops: 2, total: 2 },
+      udp: { ...rx, rateHz: 25.05, rateErrorPct: 0.148 },
+    };
+    const rows = targets([myo(), delsys, loaded]);
+    const by = (id: string) => rows.find((r) => r.id === id)!;
+    expect(by("delay-delsys-acquisition")).toMatchObject({ limit: 3, value: 2.9, pass: true });
+    expect(by("delay-delsys-sender")).toMatchObject({ limit: 3, value: 3.2, pass: false });
+    expect(by("cpu-myo").limit).toBe(1.5);
+    expect(by("cpu-delsys").limit).toBe(3);
+    expect(by("cpu-hdemg-features").limit).toBe(8);
+    expect(by("ontime-delsys")).toMatchObject({ value: 100, pass: true });
+    expect(by("lost-quiet")).toMatchObject({ value: 0, pass: true });
+    expect(by("lost-quiet").note).toBe(
+      "myo 0 (0 missed, 0 dropped), delsys 0 (0 missed, 0 dropped)",
+    );
+    expect(by("lost-delsys-loaded")).toMatchObject({ value: 2, pass: false });
+    expect(by("udp-rate-delsys-loaded")).toMatchObject({ limit: 0.1, pass: false });
+    expect(by("udp-rate-delsys-loaded").display).toBe("25.0500 Hz (+0.148 %)");
+    expect(udpRxLine(rx)).toContain(
+      "750 events at **25.0125 Hz** by arrival (−0.002 % vs 25.0130 Hz",
+    );
+    expect(pipelineMarkdown(loaded).join("\n")).toContain("burned 98.0 % of a core");
+  });
+
+  test("the batching sweep prints one row per pipeline and interval", () => {
+    const r: BatchingResult = {
+      kind: "batching",
+      id: "batching",
+      title: "Batching sweep",
+      ok: false,
+      error: "1 of 2 runs failed",
+      warmupSeconds: 5,
+      steadySeconds: 15,
+      intervalsMs: [0, 2],
+      rows: [
+        {
+          pipeline: "delsys",
+          batchingMs: 0,
+          ok: true,
+          cpuMedianPct: 6.5,
+          engineWakeupsPerS: 1931,
+          sender: { p50Ms: 0.1, p99Ms: 0.4, maxMs: 1 },
+          acquisition: { name: "Delsys", p50Ms: 0.05, p99Ms: 0.3, maxMs: 1 },
+          udpRateHz: 25.013,
+          samplesLost: 0,
+          loadAvgBefore: [0.5, 0.4, 0.3],
+        },
+        {
+          pipeline: "delsys",
+          batchingMs: 2,
+          ok: false,
+          error: "boom",
+          cpuMedianPct: NaN,
+          engineWakeupsPerS: NaN,
+          sender: null,
+          acquisition: null,
+          udpRateHz: NaN,
+          samplesLost: null,
+          loadAvgBefore: [0.5, 0.4, 0.3],
+        },
+      ],
+      loadAvgBefore: [0.5, 0.4, 0.3],
+      loadAvgAfter: [0.5, 0.4, 0.3],
+      killedAfterSummary: false,
+    };
+    const md = batchingMarkdown(r);
+    expect(md).toContain(
+      "| delsys | 0 | 6.50 | 1931 | 0.100 / 0.400 | Delsys: 0.050 / 0.300 | 25.0130 | 0 | 0.50 / 0.40 / 0.30 |",
+    );
+    expect(md).toContain("| delsys | 2 | failed: boom | - | - | - | - | - | 0.50 / 0.40 / 0.30 |");
+  });
+
+  test("--only: an id selects that workload alone, a group name or NAME* the group", () => {
+    expect(selects("delsys", "delsys")).toBe(true);
+    expect(selects("delsys", "delsys-loaded")).toBe(false);
+    expect(selects("delsys*", "delsys-loaded")).toBe(true);
+    expect(selects("timer", "timer-precision")).toBe(false);
+    expect(selects("timer*", "timer-precision")).toBe(true);
+    expect(selects("replay", "replay-32")).toBe(true);
+    expect(selects("replay", "replay-256")).toBe(true);
+    expect(selects("batching", "batching")).toBe(true);
   });
 
   test("the learning micro-benchmark table: ns per update and prediction, CPU at 25 Hz", () => {

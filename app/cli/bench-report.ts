@@ -2,6 +2,9 @@
  * `mosaic bench`, report side: result types, DESIGN.md §6 targets, MOSAIC's published figures
  * (paper section V: Tables 5 and 6, Fig. 6 and 7) and the Markdown tables.
  */
+import type { UdpRxFigures } from "./bench-receiver";
+
+export type { UdpRxFigures };
 
 export interface StatusShares {
   /** % of the steady-state telemetry lines (20 Hz) in each status. */
@@ -25,6 +28,9 @@ export interface BlockRow {
   calls: number;
   /** Events dropped on the edges into the block during the measured interval. */
   dropsIn: number;
+  /** Delivery delay (processing − timestamp of the oldest event of each batch) since the
+   * warm-up reset, ms; n batches. */
+  delay: { p50Ms: number; p99Ms: number; maxMs: number; n: number } | null;
   shares: StatusShares | null;
   /** The block's status line at the end of the run (Python blocks: call times, over budget). */
   text?: string;
@@ -58,8 +64,12 @@ export interface CpuFigures {
   childrenMeanPct: number;
   clkTck: number;
   /** Steady-state CPU of each thread (schedstat; busiest first; threads under 0.05 % left out).
-   * `main` is the CLI's main thread; the others are named by tid (Node names them all "node"). */
-  threads: { thread: string; pct: number }[];
+   * `main` is the CLI's main thread; the others are named by tid (Node names them all "node").
+   * wakeupsPerS: voluntary context switches per second (the thread blocked and was woken). */
+  threads: { thread: string; pct: number; wakeupsPerS: number; preemptedPerS: number }[];
+  /** Wake-ups per second of the busiest thread other than the CLI's main thread (normally the
+   * engine worker), over the steady-state window; NaN when unknown. */
+  engineWakeupsPerS: number;
   trace: { t: number; pct: number; ticksPct: number; rssMiB: number; steady: boolean }[];
 }
 
@@ -78,8 +88,25 @@ export interface PipelineResult {
   /** Seconds covered by the ΔT statistics (warm-up end → stop), from the summary. */
   measuredSeconds: number;
   cpu: CpuFigures | null;
-  /** CPU of a bare worker that only sleeps until each deadline at the same timer rate (% of one core). */
+  /** CPU of a bare worker that only sleeps until each deadline at the pipeline's wake-up rate (the
+   * timer rate batched by batchingMs), % of one core, and that rate (Hz). */
   wakeFloorPct?: number;
+  wakeFloorHz?: number;
+  /** The batching interval of the pipeline's first ScheduledTimer, ms (from its telemetry). */
+  batchingMs: number;
+  /** The acquisition block (the simulated device), e.g. Delsys. */
+  acquisition?: string;
+  /** Blocks at the acquisition rate (the first ScheduledTimer's), the paper's acquisition chain. */
+  acquisitionChain: string[];
+  /** Samples lost after the warm-up: ticks the timers missed plus events dropped on the edges
+   * out of the acquisition chain's blocks (must be 0). */
+  samplesLost: { missedTicks: number; acquisitionDrops: number; total: number } | null;
+  /** The lowest on-time share (Table 6, G) of the acquisition chain's blocks, %. */
+  acquisitionOnTimePct: number;
+  /** What the bench's UDP receiver got from the Sender in the steady-state window. */
+  udp?: UdpRxFigures;
+  /** A neighbour process that burned one core during the run (the loaded variant). */
+  neighbour?: { command: string; cpuPct: number };
   /** Σ of the blocks' measured `process` time over the measured interval, % of one core. */
   blocksComputePct: number;
   memory: { peakRssMiB: number; steadyRssMedianMiB: number } | null;
@@ -166,6 +193,8 @@ export interface UdpResult {
   rate: number;
   channels: number;
   timerHz: number;
+  /** The batching interval of the host, ms. */
+  batchingMs: number;
   p50Ms: number;
   p90Ms: number;
   p99Ms: number;
@@ -181,7 +210,39 @@ export interface UdpResult {
   killedAfterSummary: false;
 }
 
-export type WorkloadResult = PipelineResult | ReplayResult | LearnResult | UdpResult;
+/** One run of the batching sweep. */
+export interface BatchingRow {
+  pipeline: string;
+  batchingMs: number;
+  ok: boolean;
+  error?: string;
+  cpuMedianPct: number;
+  /** Voluntary context switches per second of the busiest non-main thread (the engine worker). */
+  engineWakeupsPerS: number;
+  sender: { p50Ms: number; p99Ms: number; maxMs: number } | null;
+  acquisition: { name: string; p50Ms: number; p99Ms: number; maxMs: number } | null;
+  udpRateHz: number;
+  samplesLost: number | null;
+  loadAvgBefore: number[];
+}
+
+export interface BatchingResult {
+  kind: "batching";
+  id: string;
+  title: string;
+  ok: boolean;
+  error?: string;
+  warmupSeconds: number;
+  steadySeconds: number;
+  intervalsMs: number[];
+  rows: BatchingRow[];
+  loadAvgBefore: number[];
+  loadAvgAfter: number[];
+  killedAfterSummary: boolean;
+}
+
+export type WorkloadResult =
+  PipelineResult | ReplayResult | LearnResult | UdpResult | BatchingResult;
 
 export interface TargetRow {
   id: string;
@@ -382,10 +443,6 @@ function fmtRate(x: number): string {
   return Number.isInteger(x) ? String(x) : x.toFixed(4);
 }
 
-function fmtMs(x: number): string {
-  return !Number.isFinite(x) ? "-" : `${(x * 1000).toFixed(3)} ms`;
-}
-
 export function fmtRateSI(x: number): string {
   if (!Number.isFinite(x)) return "-";
   if (x >= 1e6) return `${(x / 1e6).toFixed(2)} M`;
@@ -461,7 +518,8 @@ export function targets(results: WorkloadResult[]): TargetRow[] {
         note: c
           ? `p90 ${fmtPct(c.p90Pct)}, mean ${fmtPct(c.meanPct)} ± ${fmtPct(c.stdPct)} (${c.samples} samples); /proc/stat ticks: median ${fmtPct(c.ticksMedianPct)}, mean ${fmtPct(c.ticksMeanPct)}` +
             (r?.wakeFloorPct !== undefined
-              ? `; wake-up floor on this machine (a bare worker sleeping at the same rate, nothing else): ${fmtPct(r.wakeFloorPct)}`
+              ? `; wake-up floor on this machine (a bare worker waking at the pipeline's ${fmt(r.wakeFloorHz, 1)} Hz, nothing else): ${fmtPct(r.wakeFloorPct)}` +
+                `; engine thread ${fmt(c.engineWakeupsPerS, 0)} wake-ups/s, batching interval ${fmt(r.batchingMs, 1)} ms`
               : "")
           : "",
       },
@@ -474,7 +532,7 @@ export function targets(results: WorkloadResult[]): TargetRow[] {
       "myo",
       "Myo pipeline, 8 ch @ 200 Hz",
       `${PAPER_CPU.myo.pct8} % ± ${PAPER_CPU.myo.sd8} % of 8 cores ≈ ${PAPER_CPU.myo.cores.toFixed(2)} core (≈ ${(PAPER_CPU.myo.cores * 100).toFixed(0)} % of one core)`,
-      2,
+      1.5,
     ),
   );
   rows.push(
@@ -482,16 +540,16 @@ export function targets(results: WorkloadResult[]): TargetRow[] {
       "delsys",
       "Delsys pipeline, 32 ch @ 1926 Hz",
       `${PAPER_CPU.delsys.pct8} % ± ${PAPER_CPU.delsys.sd8} % of 8 cores ≈ ${PAPER_CPU.delsys.cores.toFixed(2)} cores (≈ ${(PAPER_CPU.delsys.cores * 100).toFixed(0)} % of one core)`,
-      5,
+      3,
     ),
   );
-  rows.push(cpuRow("hdemg", "High-density EMG, 256 ch @ 2048 Hz", "not reported", 10));
+  rows.push(cpuRow("hdemg", "High-density EMG, 256 ch @ 2048 Hz", "not reported", 8));
   rows.push(
     cpuRow(
       "hdemg-features",
       "High-density EMG features (MAV, WL, ZC, SSC on 200 ms windows every 25 ms), 256 ch @ 2048 Hz",
       "not reported",
-      10,
+      8,
     ),
   );
   {
@@ -524,13 +582,13 @@ export function targets(results: WorkloadResult[]): TargetRow[] {
     const t = r?.ok ? r.timers[0] : undefined;
     const paper = "not reported; ΔT std 0.24–0.38 ms for the acquisition blocks (Table 5)";
     const note = t
-      ? `max ${t.latenessMaxUs.toFixed(0)} µs, ${t.missed} of ${t.fired + t.missed} ticks missed; timer ΔT std ${fmtMs(r!.blocks.find((b) => b.name === t.name)?.stdDt ?? NaN)}`
+      ? `batching interval ${fmt(r!.batchingMs, 0)} ms (\`--batching-ms 0\`: a wake-up for every tick); max ${t.latenessMaxUs.toFixed(0)} µs, ${t.fired} ticks fired, ${t.missed} missed`
       : "";
     rows.push(
       judged(
         {
           id: "timer-p50",
-          workload: "Timer at 2 kHz, default mode",
+          workload: "Timer at 2 kHz, default mode, batching interval 0",
           metric: "lateness (fire − deadline), median, µs",
           paper,
           target: "median ≤ 100 µs",
@@ -548,7 +606,7 @@ export function targets(results: WorkloadResult[]): TargetRow[] {
       judged(
         {
           id: "timer-p99",
-          workload: "Timer at 2 kHz, default mode",
+          workload: "Timer at 2 kHz, default mode, batching interval 0",
           metric: "lateness (fire − deadline), p99, µs",
           paper,
           target: "p99 ≤ 200 µs",
@@ -570,7 +628,7 @@ export function targets(results: WorkloadResult[]): TargetRow[] {
       judged(
         {
           id: "timer-precision",
-          workload: "Timer at 2 kHz, `--precision` (spin the last ~0.3 ms)",
+          workload: "Timer at 2 kHz, `--precision` (spin the last ~0.3 ms), batching interval 0",
           metric: "lateness median / p99, µs; CPU median",
           paper: "not available in MOSAIC",
           target: "none (information)",
@@ -587,12 +645,40 @@ export function targets(results: WorkloadResult[]): TargetRow[] {
       ),
     );
   }
+  {
+    const r = pipeline(results, "delsys");
+    for (const which of ["Sender", "acquisition"] as const) {
+      const name = which === "Sender" ? "Sender" : (r?.acquisition ?? "Delsys");
+      const b = r?.ok ? r.blocks.find((x) => x.name === name) : undefined;
+      const limit = r?.ok && Number.isFinite(r.batchingMs) ? r.batchingMs + 1 : null;
+      rows.push(
+        judged(
+          {
+            id: `delay-delsys-${which.toLowerCase()}`,
+            workload: `Delsys pipeline, default batching interval: ${which === "Sender" ? "the UDP Sender" : `the acquisition block (${name})`}`,
+            metric: "delivery delay (processing − event time), p99, ms",
+            paper: "not reported",
+            target: "p99 ≤ interval + 1 ms",
+            limit,
+            sense: "max",
+            unit: "ms",
+            value: b?.delay ? b.delay.p99Ms : null,
+            note: b?.delay
+              ? `interval ${fmt(r!.batchingMs, 1)} ms; p50 ${fmt(b.delay.p50Ms, 3)} ms, max ${fmt(b.delay.maxMs, 2)} ms over ${b.delay.n} batches`
+              : "",
+          },
+          (v) => `${v.toFixed(3)} ms`,
+          why(r, "delsys"),
+        ),
+      );
+    }
+  }
   const u = results.find((r): r is UdpResult => r.kind === "udp");
   rows.push(
     judged(
       {
         id: "latency-udp",
-        workload: "Sensor frame in → UDP datagram out, same worker",
+        workload: "Sensor frame in → UDP datagram out, same worker, batching interval 0",
         metric: "p99 latency",
         paper: "not reported",
         target: "p99 ≤ 1 ms",
@@ -602,7 +688,7 @@ export function targets(results: WorkloadResult[]): TargetRow[] {
         value: u?.ok ? u.p99Ms : null,
         note: u?.ok
           ? `UdpReceiver → Function → UdpSender, ${u.channels} f64 per datagram at ${u.rate} Hz on loopback` +
-            `${u.timerHz > 0 ? `, a ${u.timerHz} Hz timer branch on the same worker` : ""}; p50 ` +
+            `${u.timerHz > 0 ? `, a ${u.timerHz} Hz timer branch on the same worker` : ""}, batching interval ${fmt(u.batchingMs, 0)} ms; p50 ` +
             `${u.p50Ms.toFixed(3)} ms, p90 ${u.p90Ms.toFixed(3)} ms, max ${u.maxMs.toFixed(2)} ms ` +
             `(${u.received}/${u.samples} timed, ${u.lost} lost); socket → Rx callback p50 ` +
             `${u.inP50Ms.toFixed(3)} / p99 ${u.inP99Ms.toFixed(3)} ms, Rx callback → datagram out p50 ` +
@@ -636,6 +722,114 @@ export function targets(results: WorkloadResult[]): TargetRow[] {
         },
         (v) => `${fmtRateSI(v)} ch-samples/s`,
         why(r, id),
+      ),
+    );
+  }
+  for (const [id, label] of [
+    ["myo", "Myo pipeline, quiet machine"],
+    ["delsys", "Delsys pipeline, quiet machine"],
+  ] as const) {
+    const r = pipeline(results, id);
+    const ok = r?.ok && Number.isFinite(r.acquisitionOnTimePct);
+    rows.push(
+      judged(
+        {
+          id: `ontime-${id}`,
+          workload: label,
+          metric: "Table 6: on-time share (G) of the acquisition chain, lowest block, %",
+          paper:
+            id === "myo" ? "100 % (every block)" : "98.3–99.2 % (Delsys, Amplification, LowPass)",
+          target: "≥ 99.9 % on time",
+          limit: 99.9,
+          sense: "min",
+          unit: "%",
+          value: ok ? r.acquisitionOnTimePct : null,
+          note: ok
+            ? `${r.acquisitionChain.join(", ")}; load average before ${load(r.loadAvgBefore)} (a busy neighbour makes blocks lag)`
+            : "",
+        },
+        (v) => `${v.toFixed(3)} %`,
+        why(r, id),
+      ),
+    );
+  }
+  {
+    const quiet = results.filter(
+      (r): r is PipelineResult => r.kind === "pipeline" && !r.neighbour && r.samplesLost !== null,
+    );
+    const total = quiet.reduce((a, r) => a + r.samplesLost!.total, 0);
+    rows.push(
+      judged(
+        {
+          id: "lost-quiet",
+          workload: "Every pipeline run without a neighbour",
+          metric: "samples lost after the warm-up (missed ticks + drops on the acquisition chain)",
+          paper: "not reported (MOSAIC had no drop counters)",
+          target: "0",
+          limit: 0,
+          sense: "max",
+          unit: "samples",
+          value: quiet.length ? total : null,
+          note: quiet
+            .map(
+              (r) =>
+                `${r.id} ${r.samplesLost!.total} (${r.samplesLost!.missedTicks} missed, ${r.samplesLost!.acquisitionDrops} dropped)`,
+            )
+            .join(", "),
+        },
+        (v) => String(v),
+        "no pipeline run",
+      ),
+    );
+  }
+  {
+    const r = pipeline(results, "delsys-loaded");
+    const ok = r?.ok === true;
+    const n = r?.neighbour
+      ? `a neighbour process burned ${fmtPct(r.neighbour.cpuPct)} of a core (\`${r.neighbour.command}\`); `
+      : "";
+    rows.push(
+      judged(
+        {
+          id: "lost-delsys-loaded",
+          workload: "Delsys pipeline while a neighbour burns one core",
+          metric: "samples lost after the warm-up (missed ticks + drops on the acquisition chain)",
+          paper: "not reported",
+          target: "0 samples lost under load",
+          limit: 0,
+          sense: "max",
+          unit: "samples",
+          value: ok && r.samplesLost ? r.samplesLost.total : null,
+          note:
+            ok && r.samplesLost
+              ? `${n}${r.samplesLost.missedTicks} ticks missed, ${r.samplesLost.acquisitionDrops} dropped; acquisition chain on time ${fmt(r.acquisitionOnTimePct, 3)} % (lowest block)`
+              : "",
+        },
+        (v) => String(v),
+        why(r, "delsys-loaded"),
+      ),
+    );
+    const x = ok ? r.udp : undefined;
+    rows.push(
+      judged(
+        {
+          id: "udp-rate-delsys-loaded",
+          workload: "Delsys pipeline while a neighbour burns one core",
+          metric: "UDP rate at the receiver (events/s by arrival), deviation from 25.013 Hz",
+          paper: "25.0204 Hz at the UDP Sender (Table 5, quiet)",
+          target: "within 0.1 % of 25.013 Hz",
+          limit: 0.1,
+          sense: "max",
+          unit: "%",
+          value: x && Number.isFinite(x.rateErrorPct) ? Math.abs(x.rateErrorPct) : null,
+          note: x
+            ? `${x.events} events, ${x.datagrams} of ${x.expectedDatagrams} expected datagrams in ${x.windowSeconds} s; ${x.counterGaps} missing by the counter, ${x.missingEvents} events missing by the timestamps; longest gap between events ${x.maxArrivalGapMs.toFixed(1)} ms`
+            : ok
+              ? "no UDP figures"
+              : "",
+        },
+        (v) => `${fmt(x?.rateHz, 4)} Hz (${x && x.rateErrorPct < 0 ? "−" : "+"}${v.toFixed(3)} %)`,
+        why(r, "delsys-loaded"),
       ),
     );
   }
@@ -705,12 +899,19 @@ export function pipelineMarkdown(r: PipelineResult, heading = "###"): string[] {
     if (r.wakeFloorPct !== undefined) {
       res.push(
         `Wake-up floor: a bare Node worker that only sleeps in Atomics.wait until each deadline at the ` +
-          `same rate (no engine, no blocks) uses ${fmtPct(r.wakeFloorPct)} of one core on this machine`,
+          `pipeline's wake-up rate (${fmt(r.wakeFloorHz, 1)} Hz; no engine, no blocks) uses ` +
+          `${fmtPct(r.wakeFloorPct)} of one core on this machine`,
       );
     }
     if (c.threads.length) {
       res.push(
-        `CPU by thread (steady-state mean): ${c.threads.map((t) => `${t.thread} ${fmtPct(t.pct)}`).join(", ")}`,
+        `CPU by thread (steady-state mean; wake-ups = voluntary context switches per second): ` +
+          c.threads
+            .map(
+              (t) =>
+                `${t.thread} ${fmtPct(t.pct)}${Number.isFinite(t.wakeupsPerS) ? ` (${t.wakeupsPerS.toFixed(0)} wake-ups/s)` : ""}`,
+            )
+            .join(", "),
       );
     }
   }
@@ -719,16 +920,30 @@ export function pipelineMarkdown(r: PipelineResult, heading = "###"): string[] {
       `Memory: peak RSS (VmHWM) ${m.peakRssMiB.toFixed(1)} MiB, steady-state VmRSS median ${m.steadyRssMedianMiB.toFixed(1)} MiB`,
     );
   }
+  if (r.neighbour) {
+    res.push(
+      `Load: a neighbour process (\`${r.neighbour.command}\`, normal priority) burned ` +
+        `${fmtPct(r.neighbour.cpuPct)} of a core for the whole run`,
+    );
+  }
   for (const t of r.timers) {
     res.push(
-      `Timer ${t.name} (${t.desiredRate} Hz): ${t.fired} ticks fired, ${t.missed} missed after the warm-up; ` +
+      `Timer ${t.name} (${t.desiredRate} Hz, batching interval ${fmt(r.batchingMs, 1)} ms): ${t.fired} ticks fired, ${t.missed} missed after the warm-up; ` +
         `lateness median ${t.latenessP50Us.toFixed(0)} µs, p99 ${t.latenessP99Us.toFixed(0)} µs, max ${t.latenessMaxUs.toFixed(0)} µs`,
+    );
+  }
+  if (r.samplesLost) {
+    res.push(
+      `Samples lost after the warm-up: **${r.samplesLost.total}** (${r.samplesLost.missedTicks} ticks missed, ` +
+        `${r.samplesLost.acquisitionDrops} events dropped on the edges out of the acquisition chain: ` +
+        `${r.acquisitionChain.join(", ")})`,
     );
   }
   res.push(
     `Drops on edges: ${r.drops} after the warm-up (${r.dropsAllTime} in all); start-up (process start to ` +
       `pipeline running) ${r.loadSeconds.toFixed(2)} s`,
   );
+  if (r.udp) res.push(udpRxLine(r.udp));
   for (const b of r.blocks) {
     if (b.type === "Python" && b.text) {
       res.push(
@@ -741,7 +956,10 @@ export function pipelineMarkdown(r: PipelineResult, heading = "###"): string[] {
   out.push("");
 
   out.push(
-    "Table 5 — timing consistency (ΔT between consecutive outputs, emission clock, after the warm-up)",
+    "Table 5 — timing consistency after the warm-up: ΔT between the timestamps of consecutive " +
+      "output events (a tick is stamped with its deadline, so the jitter of waking shows in the " +
+      "delivery delay, not in ΔT), compute time per call, and delivery delay (time of processing − " +
+      "timestamp of the oldest event of each batch)",
     "",
   );
   const head5 = [
@@ -753,6 +971,9 @@ export function pipelineMarkdown(r: PipelineResult, heading = "###"): string[] {
     "Std ΔT (s)",
     "n",
     "µs/call",
+    "delay p50 (ms)",
+    "p99 (ms)",
+    "max (ms)",
   ];
   if (paper) head5.push("MOSAIC: block", "Freq. (Hz)", "Std ΔT (s)");
   // In the paper's row order (the runtime lists blocks in creation order), extra blocks last.
@@ -780,6 +1001,9 @@ export function pipelineMarkdown(r: PipelineResult, heading = "###"): string[] {
           b.n > 1 ? fmt(b.stdDt, 7) : "-",
           String(b.n),
           fmt(b.computeMeanUs, 2),
+          fmt(b.delay?.p50Ms, 3),
+          fmt(b.delay?.p99Ms, 3),
+          fmt(b.delay?.maxMs, 2),
         ];
         if (paper) {
           const p = paper[b.name];
@@ -826,14 +1050,90 @@ export function pipelineMarkdown(r: PipelineResult, heading = "###"): string[] {
           "more outputs than ticks (e.g. one per output port).",
       );
     }
-    if (b.type === "Sink" && (b.n === 0 || (b.shares?.idle ?? 0) > 50)) {
+    if (b.type !== "Sink" && b.type !== "UdpSender") continue;
+    if (b.n === 0 || (b.shares?.idle ?? 0) > 50) {
       notes.push(
-        `${b.name} is a Sink (placeholder for the UDP sender): without outputs its ΔT and status ` +
-          "come from what it consumes; here it has no ΔT or reads mostly idle.",
+        `${b.name} (${b.type}) has no outputs: its ΔT and status come from what it consumes; ` +
+          "here it has no ΔT or reads mostly idle.",
       );
     }
   }
   for (const n of notes) out.push(`Note: ${n}`, "");
+  return out;
+}
+
+/** One line about what the bench's UDP receiver got. */
+export function udpRxLine(x: UdpRxFigures): string {
+  const sign = x.rateErrorPct < 0 ? "−" : "+";
+  return (
+    `UDP at the receiver (127.0.0.1:${x.port}, the bench as the device): ${x.datagrams} datagrams in ` +
+    `${x.windowSeconds} s (${fmt(x.datagramsPerSecond, 2)}/s, ${x.perEvent} per event; ${x.expectedDatagrams} expected), ` +
+    `${x.events} events at **${fmt(x.rateHz, 4)} Hz** by arrival (${sign}${fmt(Math.abs(x.rateErrorPct), 3)} % ` +
+    `vs ${fmt(x.expectedRateHz, 4)} Hz; ${fmt(x.timestampRateHz, 4)} Hz by their timestamps); missing: ` +
+    `${x.counterGaps} datagrams by the counter, ${x.missingEvents} events by the timestamps, ` +
+    `${x.incompleteEvents} incomplete events; longest gap between events ${fmt(x.maxArrivalGapMs, 1)} ms` +
+    (x.malformed > 0 ? `; ${x.malformed} malformed (${x.firstMalformed ?? "?"})` : "")
+  );
+}
+
+/** The batching sweep: CPU, wake-ups and delivery delay per pipeline and interval. */
+export function batchingMarkdown(r: BatchingResult, heading = "##"): string[] {
+  const out: string[] = [`${heading} ${r.title}`, ""];
+  if (r.rows.length === 0) {
+    out.push(`**Failed:** ${r.error ?? "nothing ran"}`, "");
+    return out;
+  }
+  out.push(
+    `Each pipeline run with \`--batching-ms\` ${r.intervalsMs.join(", ")} (warm-up ${r.warmupSeconds} s, ` +
+      `steady state ${r.steadySeconds} s each). CPU: median of 1-s samples, % of one core. Wake-ups: ` +
+      "voluntary context switches per second of the busiest thread other than the CLI's main thread " +
+      "(the engine worker). Delay: delivery delay p50 / p99 (ms) since the warm-up. Samples lost: missed " +
+      "ticks + drops on the acquisition chain.",
+    "",
+  );
+  out.push(
+    ...table(
+      [
+        "pipeline",
+        "batching (ms)",
+        "CPU median (%)",
+        "engine wake-ups/s",
+        "Sender delay p50 / p99 (ms)",
+        "acquisition delay p50 / p99 (ms)",
+        "UDP rate (Hz)",
+        "samples lost",
+        "load avg before",
+      ],
+      r.rows.map((x) =>
+        x.ok
+          ? [
+              x.pipeline,
+              String(x.batchingMs),
+              fmt(x.cpuMedianPct, 2),
+              fmt(x.engineWakeupsPerS, 0),
+              x.sender ? `${fmt(x.sender.p50Ms, 3)} / ${fmt(x.sender.p99Ms, 3)}` : "-",
+              x.acquisition
+                ? `${x.acquisition.name}: ${fmt(x.acquisition.p50Ms, 3)} / ${fmt(x.acquisition.p99Ms, 3)}`
+                : "-",
+              fmt(x.udpRateHz, 4),
+              x.samplesLost === null ? "-" : String(x.samplesLost),
+              load(x.loadAvgBefore),
+            ]
+          : [
+              x.pipeline,
+              String(x.batchingMs),
+              `failed: ${x.error ?? "?"}`,
+              "-",
+              "-",
+              "-",
+              "-",
+              "-",
+              load(x.loadAvgBefore),
+            ],
+      ),
+    ),
+    "",
+  );
   return out;
 }
 

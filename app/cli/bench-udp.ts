@@ -9,7 +9,9 @@
  * sensor and the device with one loopback socket: it sends streamlined datagrams to Rx at a steady
  * rate, each carrying its sequence number as value 0, and times each one until the datagram that
  * Tx sends for it arrives. The figure is therefore the whole loop (two kernel loopback hops, the
- * worker waking, the pipeline, the send): an upper bound of in → out.
+ * worker waking, the pipeline, the send): an upper bound of in → out. `mosaic bench` runs it with
+ * a batching interval of 0 (`batchingMs`: the timer branch wakes the worker for every tick, as
+ * DESIGN.md §6 states the target); a datagram wakes the I/O worker at once whatever the interval.
  *
  * Run on its own:
  *   node scripts/build-ts.mjs && node_modules/.bin/esbuild app/cli/bench-udp.ts --bundle \
@@ -34,6 +36,9 @@ export interface UdpLatencyOptions {
   timerHz?: number;
   /** The host's precision mode (spins the last ~0.3 ms before each tick). */
   precision?: boolean;
+  /** The batching interval of the timer branch, ms (`mosaic run --batching-ms`; default: the
+   * engine's default). */
+  batchingMs?: number;
   workerPath?: string;
   wasmPath?: string;
 }
@@ -45,6 +50,8 @@ export interface UdpLatencyResult {
   rate: number;
   channels: number;
   timerHz: number;
+  /** The batching interval the host ran with, ms (NaN: the engine's default). */
+  batchingMs: number;
   p50Ms: number;
   p90Ms: number;
   p99Ms: number;
@@ -163,6 +170,7 @@ export async function measureUdpLatency(opts: UdpLatencyOptions = {}): Promise<U
     {
       mode: "realtime",
       precision: opts.precision ?? false,
+      ...(opts.batchingMs !== undefined ? { batchingS: opts.batchingMs / 1000 } : {}),
       ...(opts.workerPath ? { workerPath: opts.workerPath } : {}),
       ...(opts.wasmPath ? { wasmPath: opts.wasmPath } : {}),
     },
@@ -234,6 +242,7 @@ export async function measureUdpLatency(opts: UdpLatencyOptions = {}): Promise<U
     rate,
     channels,
     timerHz,
+    batchingMs: opts.batchingMs ?? NaN,
     p50Ms: quantileMs(timed, 0.5),
     p90Ms: quantileMs(timed, 0.9),
     p99Ms: quantileMs(timed, 0.99),
@@ -251,7 +260,7 @@ export function udpLatencyLine(r: UdpLatencyResult): string {
   const f = (x: number) => x.toFixed(3);
   return (
     `UDP in → pipeline → UDP out (${r.channels} ch f64 @ ${r.rate} Hz, timer branch ` +
-    `${r.timerHz > 0 ? `${r.timerHz} Hz` : "none"}): p50 ${f(r.p50Ms)} ms, p90 ${f(r.p90Ms)} ms, ` +
+    `${r.timerHz > 0 ? `${r.timerHz} Hz` : "none"}${Number.isFinite(r.batchingMs) ? `, batching interval ${r.batchingMs} ms` : ""}): p50 ${f(r.p50Ms)} ms, p90 ${f(r.p90Ms)} ms, ` +
     `p99 ${f(r.p99Ms)} ms, max ${f(r.maxMs)} ms (${r.received}/${r.samples} timed, ${r.lost} lost; ` +
     `target p99 ≤ 1 ms); in → Rx callback p50 ${f(r.inP50Ms)} / p99 ${f(r.inP99Ms)} ms, ` +
     `Rx callback → out p50 ${f(r.outP50Ms)} / p99 ${f(r.outP99Ms)} ms`
@@ -259,6 +268,7 @@ export function udpLatencyLine(r: UdpLatencyResult): string {
 }
 
 // Run directly: node dist/bench-udp.mjs [--json] [--samples N] [--rate HZ] [--timer HZ]
+//   [--batching-ms MS]
 const invoked = process.argv[1] ?? "";
 if (/bench-udp\.(mjs|js|ts)$/.test(invoked)) {
   const arg = (name: string): number | undefined => {
@@ -269,11 +279,13 @@ if (/bench-udp\.(mjs|js|ts)$/.test(invoked)) {
   const rate = arg("rate");
   const timerHz = arg("timer");
   const channels = arg("channels");
+  const batchingMs = arg("batching-ms");
   measureUdpLatency({
     ...(samples !== undefined ? { samples } : {}),
     ...(rate !== undefined ? { rate } : {}),
     ...(timerHz !== undefined ? { timerHz } : {}),
     ...(channels !== undefined ? { channels } : {}),
+    ...(batchingMs !== undefined ? { batchingMs } : {}),
     precision: process.argv.includes("--precision"),
   }).then(
     (r) => {

@@ -29,16 +29,22 @@ import {
   quantile,
   runChild,
   schedstatAvailable,
+  startNeighbour,
   std,
+  wakeRate,
   type ChildRun,
 } from "./bench-proc";
+import { BenchReceiver } from "./bench-receiver";
 import {
+  batchingMarkdown,
   learnMarkdown,
   load,
   pipelineMarkdown,
   replayMarkdown,
   targets,
   targetsTable,
+  type BatchingResult,
+  type BatchingRow,
   type BlockRow,
   type CpuFigures,
   type LearnResult,
@@ -56,15 +62,17 @@ Usage:
   mosaic bench [--duration S] [--warmup S] [--only NAME[,NAME]] [--out DIR] [--quick]
 
 Runs each workload as a child \`mosaic run … --json\` and measures it from outside (CPU and RSS
-from /proc every second; ΔT statistics and status shares from the run's telemetry). Prints
-Markdown tables and writes DIR/latest.json and DIR/latest.md (default DIR: bench/results).
+from /proc every second; ΔT statistics, delivery delay and status shares from the run's
+telemetry; the pipelines' UDP output with a receiver in this process). Prints Markdown tables
+and writes DIR/latest.json and DIR/latest.md (default DIR: bench/results).
 
   --duration S  steady-state seconds per pipeline after the warm-up (default 30; the timer
-                workloads use half, at least 2)
+                workloads and every run of the batching sweep use half, at least 2)
   --warmup S    seconds excluded at the start of each real-time run (default 5)
-  --only LIST   run only these workloads: ${"myo, delsys, hdemg, hdemg-features, timer, timer-precision, replay-32, replay-256, learn, udp, python-cnn"}
-                (a prefix before '-' selects a group: timer, replay); learn is the
-                micro-benchmark of the learning kernels (ns per update and prediction)
+  --only LIST   run only these workloads: ${"myo, delsys, delsys-loaded, hdemg, hdemg-features, python-cnn, timer, timer-precision, replay-32, replay-256, learn, udp, batching"}
+                (an id selects that workload; replay, or NAME* as in 'timer*', selects a
+                group); learn is the micro-benchmark of the learning kernels (ns per update
+                and prediction); batching runs Delsys and Myo at --batching-ms 0, 1, 2, 5, 10
   --out DIR     where to write latest.json and latest.md
   --quick       a smoke test: 1 s warm-up, 3 s steady state, short replays (about 40 s in all)
 
@@ -81,6 +89,21 @@ interface PipelineDef {
   extra?: string[];
   /** The timer workloads run for half the steady-state duration. */
   short?: boolean;
+  /** The acquisition block (the simulated device). */
+  acquisition?: string;
+  /** The rate the Sender sends events at (Hz): the bench receives on the Sender's port (read
+   * from the file) and checks the rate and the gaps against this. */
+  udpRateHz?: number;
+  /** Run while a neighbour process burns one core. */
+  neighbour?: boolean;
+}
+interface BatchingDef {
+  kind: "batching";
+  id: string;
+  title: string;
+  /** Ids of the pipeline workloads swept. */
+  pipelines: string[];
+  intervalsMs: number[];
 }
 interface ReplayDef {
   kind: "replay";
@@ -103,7 +126,12 @@ interface UdpDef {
   title: string;
   timerHz: number;
 }
-type WorkloadDef = PipelineDef | ReplayDef | LearnDef | UdpDef;
+type WorkloadDef = PipelineDef | ReplayDef | LearnDef | UdpDef | BatchingDef;
+
+/** 1926 Hz / 77: the Delsys pipelines' 25 Hz branch (MOSAIC's 25.013 Hz). */
+const DELSYS_25 = 1926 / 77;
+/** 2048 Hz / 82: the high-density pipeline's 25 Hz branch. */
+const HDEMG_25 = 2048 / 82;
 
 const WORKLOADS: WorkloadDef[] = [
   {
@@ -112,6 +140,8 @@ const WORKLOADS: WorkloadDef[] = [
     title: "(a) Myo pipeline — 8 ch @ 200 Hz",
     file: "myo.yaml",
     paper: "myo",
+    acquisition: "Myo",
+    udpRateHz: 25,
   },
   {
     kind: "pipeline",
@@ -119,18 +149,34 @@ const WORKLOADS: WorkloadDef[] = [
     title: "(b) Delsys pipeline — 32 ch @ 1926 Hz",
     file: "delsys.yaml",
     paper: "delsys",
+    acquisition: "Delsys",
+    udpRateHz: DELSYS_25,
+  },
+  {
+    kind: "pipeline",
+    id: "delsys-loaded",
+    title: "(b) Delsys pipeline — 32 ch @ 1926 Hz, while a neighbour process burns one core",
+    file: "delsys.yaml",
+    paper: "delsys",
+    acquisition: "Delsys",
+    udpRateHz: DELSYS_25,
+    neighbour: true,
   },
   {
     kind: "pipeline",
     id: "hdemg",
     title: "(c) High-density EMG — 256 ch @ 2048 Hz",
     file: "hdemg.yaml",
+    acquisition: "HDEMG",
+    udpRateHz: HDEMG_25,
   },
   {
     kind: "pipeline",
     id: "hdemg-features",
     title: "(d) High-density EMG features — 256 ch @ 2048 Hz, 200 ms windows every 25 ms",
     file: "hdemg-features.yaml",
+    acquisition: "HDEMG",
+    udpRateHz: 2048 / 51,
   },
   {
     kind: "pipeline",
@@ -138,20 +184,23 @@ const WORKLOADS: WorkloadDef[] = [
     title:
       "(e) Deep model in the Python sidecar — 32 ch @ 1926 Hz, 200-sample windows every 77 (25 Hz), ONNX 1-D CNN, control, UDP",
     file: "python-cnn.yaml",
+    acquisition: "Delsys",
+    udpRateHz: DELSYS_25,
   },
   {
     kind: "pipeline",
     id: "timer",
-    title: "Timer at 2 kHz, default mode",
+    title: "Timer at 2 kHz, default mode, batching interval 0",
     file: "timer-2khz.yaml",
+    extra: ["--batching-ms", "0"],
     short: true,
   },
   {
     kind: "pipeline",
     id: "timer-precision",
-    title: "Timer at 2 kHz, --precision",
+    title: "Timer at 2 kHz, --precision, batching interval 0",
     file: "timer-2khz.yaml",
-    extra: ["--precision"],
+    extra: ["--batching-ms", "0", "--precision"],
     short: true,
   },
   {
@@ -181,8 +230,17 @@ const WORKLOADS: WorkloadDef[] = [
   {
     kind: "udp",
     id: "udp",
-    title: "UDP latency — datagram in → UdpReceiver → Function → UdpSender → datagram out",
+    title:
+      "UDP latency — datagram in → UdpReceiver → Function → UdpSender → datagram out (batching interval 0)",
     timerHz: 200,
+  },
+  {
+    kind: "batching",
+    id: "batching",
+    title:
+      "Batching sweep — the Delsys and Myo pipelines at --batching-ms 0, 1, 2, 5, 10: CPU, engine wake-ups, delivery delay",
+    pipelines: ["delsys", "myo"],
+    intervalsMs: [0, 1, 2, 5, 10],
   },
 ];
 
@@ -263,7 +321,13 @@ function cpuFigures(run: ChildRun, useNs: boolean): CpuFigures | null {
     clkTck: clkTck(),
     threads: run.threads
       .filter((t) => t.pct >= 0.05)
-      .map((t) => ({ thread: t.main ? "main" : `tid ${t.tid}`, pct: round(t.pct) })),
+      .map((t) => ({
+        thread: t.main ? "main" : `tid ${t.tid}`,
+        pct: round(t.pct),
+        wakeupsPerS: round(t.voluntaryPerS, 1),
+        preemptedPerS: round(t.nonvoluntaryPerS, 1),
+      })),
+    engineWakeupsPerS: round(run.threads.find((t) => !t.main)?.voluntaryPerS ?? NaN, 1),
     trace: run.samples.map((s) => ({
       t: round(s.t, 2),
       pct: round(useNs && Number.isFinite(s.nsPct) ? s.nsPct : s.ticksPct),
@@ -295,6 +359,14 @@ function blockRows(run: ChildRun): BlockRow[] {
       computeMeanUs: tm.calls > 0 ? (tm.computeTotalMs / tm.calls) * 1000 : NaN,
       calls: tm.calls,
       dropsIn: b.dropsIn - (base.get(b.name)?.dropsIn ?? 0),
+      delay: b.delay
+        ? {
+            p50Ms: round(b.delay.p50Ms, 4),
+            p99Ms: round(b.delay.p99Ms, 4),
+            maxMs: round(b.delay.maxMs, 3),
+            n: b.delay.n,
+          }
+        : null,
       ...(b.text ? { text: b.text } : {}),
       shares:
         c && n > 0
@@ -313,11 +385,30 @@ function edgeDrops(t: Telemetry | undefined): number {
   return (t?.edges ?? []).reduce((s, e) => s + e.dropped, 0);
 }
 
+/** The Sender's destination port as written in the pipeline (`Sender: { … Port: N … }`). */
+function senderPort(file: string): number | undefined {
+  try {
+    const m = /^Sender:.*\bPort:\s*(\d+)/m.exec(readFileSync(file, "utf8"));
+    return m ? Number(m[1]) : undefined;
+  } catch {
+    return undefined;
+  }
+}
+
 async function runPipeline(
   def: PipelineDef,
-  o: { cli: string; root: string; warmup: number; steady: number; useNs: boolean },
+  o: {
+    cli: string;
+    root: string;
+    warmup: number;
+    steady: number;
+    useNs: boolean;
+    /** `--batching-ms` for this run (the batching sweep). */
+    batchingMs?: number;
+  },
 ): Promise<PipelineResult> {
-  const file = relative(o.root, join(o.root, "pipelines", "bench", def.file));
+  const path = join(o.root, "pipelines", "bench", def.file);
+  const file = relative(o.root, path);
   const total = o.warmup + o.steady + 0.5;
   const args = [
     "run",
@@ -328,18 +419,12 @@ async function runPipeline(
     "--warmup",
     String(o.warmup),
     ...(def.extra ?? []),
+    ...(o.batchingMs !== undefined ? ["--batching-ms", String(o.batchingMs)] : []),
   ];
   const before = la();
-  progress(`${def.id}: ${def.title} (${total} s)`);
-  const run = await runChild({
-    cli: o.cli,
-    args,
-    cwd: o.root,
-    steadySeconds: o.steady,
-    warmup: o.warmup > 0,
-    timeoutSeconds: total + 60,
-  });
-  const after = la();
+  progress(
+    `${def.id}: ${def.title}${o.batchingMs !== undefined ? `, --batching-ms ${o.batchingMs}` : ""} (${total} s)`,
+  );
   const base: PipelineResult = {
     kind: "pipeline",
     id: def.id,
@@ -347,8 +432,7 @@ async function runPipeline(
     ...(def.paper ? { paper: def.paper } : {}),
     file,
     args,
-    ok: run.ok,
-    ...(run.error ? { error: run.error } : {}),
+    ok: false,
     warmupSeconds: o.warmup,
     steadySeconds: o.steady,
     measuredSeconds: NaN,
@@ -359,16 +443,57 @@ async function runPipeline(
     timers: [],
     drops: 0,
     dropsAllTime: 0,
-    telemetryLines: run.telemetryLines,
+    batchingMs: NaN,
+    ...(def.acquisition ? { acquisition: def.acquisition } : {}),
+    acquisitionChain: [],
+    samplesLost: null,
+    acquisitionOnTimePct: NaN,
+    telemetryLines: 0,
     loadAvgBefore: before,
-    loadAvgAfter: after,
-    loadSeconds: round(run.loadSeconds),
-    lingerSeconds: round(run.lingerSeconds),
-    killedAfterSummary: run.killedAfterSummary,
-    warnings: run.events
-      .filter((e) => e.level !== "info")
-      .map((e) => `${e.level}: ${e.block}: ${e.message}`),
+    loadAvgAfter: before,
+    loadSeconds: NaN,
+    lingerSeconds: NaN,
+    killedAfterSummary: false,
+    warnings: [],
   };
+  // The device end: bind the Sender's port before the pipeline starts sending.
+  const port = def.udpRateHz !== undefined ? senderPort(path) : undefined;
+  let rx: BenchReceiver | undefined;
+  if (port !== undefined) {
+    try {
+      rx = await BenchReceiver.open(port);
+    } catch (e) {
+      base.error = (e as Error).message;
+      return base;
+    }
+  }
+  const neighbour = def.neighbour ? startNeighbour() : undefined;
+  let run: ChildRun;
+  try {
+    if (neighbour) await new Promise((r) => setTimeout(r, 200)); // let it start spinning
+    run = await runChild({
+      cli: o.cli,
+      args,
+      cwd: o.root,
+      steadySeconds: o.steady,
+      warmup: o.warmup > 0,
+      timeoutSeconds: total + 60,
+    });
+  } finally {
+    const burnt = neighbour?.stop();
+    if (neighbour) base.neighbour = { command: neighbour.command, cpuPct: round(burnt ?? NaN, 1) };
+    await rx?.close();
+  }
+  base.loadAvgAfter = la();
+  base.ok = run.ok;
+  if (run.error) base.error = run.error;
+  base.telemetryLines = run.telemetryLines;
+  base.loadSeconds = round(run.loadSeconds);
+  base.lingerSeconds = round(run.lingerSeconds);
+  base.killedAfterSummary = run.killedAfterSummary;
+  base.warnings = run.events
+    .filter((e) => e.level !== "info")
+    .map((e) => `${e.level}: ${e.block}: ${e.message}`);
   if (!run.summary) return base;
   const s = run.summary;
   const baseline = new Map<string, BlockTelemetry>(
@@ -387,23 +512,43 @@ async function runPipeline(
       (s.measuredSeconds * 1000)) *
       100,
   );
-  base.timers = s.blocks
-    .filter((b) => b.timer && b.type === "ScheduledTimer")
-    .map((b) => {
-      const t = b.timer!;
-      const b0 = baseline.get(b.name)?.timer;
-      return {
-        name: b.name,
-        desiredRate: b.desiredRate,
-        fired: t.fired - (b0?.fired ?? 0),
-        missed: t.missed - (b0?.missed ?? 0),
-        latenessP50Us: t.latenessP50Us,
-        latenessP99Us: t.latenessP99Us,
-        latenessMaxUs: round(t.latenessMaxUs, 1),
-      };
-    });
+  const scheduled = s.blocks.filter((b) => b.timer && b.type === "ScheduledTimer");
+  base.timers = scheduled.map((b) => {
+    const t = b.timer!;
+    const b0 = baseline.get(b.name)?.timer;
+    return {
+      name: b.name,
+      desiredRate: b.desiredRate,
+      fired: t.fired - (b0?.fired ?? 0),
+      missed: t.missed - (b0?.missed ?? 0),
+      latenessP50Us: t.latenessP50Us,
+      latenessP99Us: t.latenessP99Us,
+      latenessMaxUs: round(t.latenessMaxUs, 1),
+    };
+  });
+  base.batchingMs = scheduled[0]?.timer?.batchingMs ?? NaN;
   base.dropsAllTime = edgeDrops(s);
   base.drops = base.dropsAllTime - edgeDrops(run.baseline);
+  // The acquisition chain: the blocks at the first ScheduledTimer's rate (Timer, the device, its
+  // filters); samples are lost when a tick is missed or an edge out of the chain drops.
+  const acqRate = scheduled[0]?.desiredRate;
+  const chain = s.blocks.filter((b) => acqRate !== undefined && b.desiredRate === acqRate);
+  base.acquisitionChain = chain.map((b) => b.name);
+  const inChain = new Set(base.acquisitionChain);
+  const edges0 = new Map((run.baseline?.edges ?? []).map((e) => [`${e.from}/${e.id}`, e.dropped]));
+  const acquisitionDrops = s.edges
+    .filter((e) => inChain.has(e.from))
+    .reduce((a, e) => a + e.dropped - (edges0.get(`${e.from}/${e.id}`) ?? 0), 0);
+  const missedTicks = base.timers.reduce((a, t) => a + t.missed, 0);
+  base.samplesLost = { missedTicks, acquisitionDrops, total: missedTicks + acquisitionDrops };
+  const shares = base.blocks
+    .filter((b) => inChain.has(b.name) && b.shares)
+    .map((b) => b.shares!.ontime);
+  base.acquisitionOnTimePct = shares.length ? round(Math.min(...shares), 3) : NaN;
+  if (rx && def.udpRateHz !== undefined) {
+    const w = run.windowMs;
+    if (Number.isFinite(w.from)) base.udp = rx.figures(w.from, w.to, def.udpRateHz);
+  }
   if (o.warmup > 0 && !run.baseline) {
     base.ok = false;
     base.error = "no warmup-done line (does `mosaic run` support --warmup?)";
@@ -413,6 +558,60 @@ async function runPipeline(
     base.error = "no telemetry received during the steady state";
   }
   return base;
+}
+
+/** The batching sweep: each pipeline at each interval, shorter runs; the figures side by side. */
+async function runBatching(
+  def: BatchingDef,
+  o: { cli: string; root: string; warmup: number; steady: number; useNs: boolean },
+): Promise<BatchingResult> {
+  const before = la();
+  const rows: BatchingRow[] = [];
+  for (const id of def.pipelines) {
+    const p = WORKLOADS.find((w): w is PipelineDef => w.kind === "pipeline" && w.id === id);
+    if (!p) continue;
+    for (const ms of def.intervalsMs) {
+      const r = await runPipeline(p, { ...o, batchingMs: ms });
+      const sender = r.blocks.find((b) => b.name === "Sender")?.delay ?? null;
+      const acq = r.blocks.find((b) => b.name === p.acquisition)?.delay ?? null;
+      rows.push({
+        pipeline: id,
+        batchingMs: ms,
+        ok: r.ok,
+        ...(r.error ? { error: r.error } : {}),
+        cpuMedianPct: r.cpu?.medianPct ?? NaN,
+        engineWakeupsPerS: r.cpu?.engineWakeupsPerS ?? NaN,
+        sender: sender ? { p50Ms: sender.p50Ms, p99Ms: sender.p99Ms, maxMs: sender.maxMs } : null,
+        acquisition: acq
+          ? { name: p.acquisition!, p50Ms: acq.p50Ms, p99Ms: acq.p99Ms, maxMs: acq.maxMs }
+          : null,
+        udpRateHz: round(r.udp?.rateHz ?? NaN, 4),
+        samplesLost: r.samplesLost?.total ?? null,
+        loadAvgBefore: r.loadAvgBefore,
+      });
+      if (r.ok && r.batchingMs !== ms) {
+        rows[rows.length - 1]!.ok = false;
+        rows[rows.length - 1]!.error = `the run reported a batching interval of ${r.batchingMs} ms`;
+      }
+    }
+  }
+  const failed = rows.filter((r) => !r.ok);
+  return {
+    kind: "batching",
+    id: def.id,
+    title: def.title,
+    ok: rows.length > 0 && failed.length === 0,
+    ...(failed.length
+      ? { error: `${failed.length} of ${rows.length} runs failed: ${failed[0]!.error ?? "?"}` }
+      : {}),
+    warmupSeconds: o.warmup,
+    steadySeconds: o.steady,
+    intervalsMs: def.intervalsMs,
+    rows,
+    loadAvgBefore: before,
+    loadAvgAfter: la(),
+    killedAfterSummary: false,
+  };
 }
 
 async function runReplay(
@@ -574,6 +773,7 @@ async function runUdp(def: UdpDef, o: { quick: boolean; root: string }): Promise
       samples,
       rate: 500,
       timerHz: def.timerHz,
+      batchingMs: 0,
       workerPath: join(o.root, "dist", "engine.worker.mjs"),
       wasmPath: join(o.root, "core-wasm", "pkg", "mosaic_core_bg.wasm"),
     });
@@ -589,6 +789,7 @@ async function runUdp(def: UdpDef, o: { quick: boolean; root: string }): Promise
       rate: 500,
       channels: 8,
       timerHz: def.timerHz,
+      batchingMs: 0,
       p50Ms: NaN,
       p90Ms: NaN,
       p99Ms: NaN,
@@ -601,6 +802,16 @@ async function runUdp(def: UdpDef, o: { quick: boolean; root: string }): Promise
       loadAvgAfter: la(),
     };
   }
+}
+
+/**
+ * Whether `--only` name `n` selects workload `id`: a workload's own id selects it alone; `NAME*`,
+ * or a name that is no workload's id (`replay`), selects the group `NAME` and `NAME-…`.
+ */
+export function selects(n: string, id: string): boolean {
+  const group = n.endsWith("*") ? n.slice(0, -1) : WORKLOADS.some((w) => w.id === n) ? null : n;
+  if (group === null) return id === n;
+  return id === group || id.startsWith(group + "-");
 }
 
 function writeAtomic(file: string, text: string): void {
@@ -659,9 +870,7 @@ export async function runBench(argv: string[]): Promise<number> {
       .split(",")
       .map((s) => s.trim())
       .filter(Boolean);
-    const unknown = names.filter(
-      (n) => !WORKLOADS.some((w) => w.id === n || w.id.startsWith(n + "-")),
-    );
+    const unknown = names.filter((n) => !WORKLOADS.some((w) => selects(n, w.id)));
     if (unknown.length || names.length === 0) {
       process.stderr.write(
         `mosaic bench: unknown workload ${unknown.map((n) => `'${n}'`).join(", ") || "(none given)"}; ` +
@@ -669,7 +878,7 @@ export async function runBench(argv: string[]): Promise<number> {
       );
       return 2;
     }
-    selected = WORKLOADS.filter((w) => names.some((n) => w.id === n || w.id.startsWith(n + "-")));
+    selected = WORKLOADS.filter((w) => names.some((n) => selects(n, w.id)));
   }
 
   const cli = findCli();
@@ -721,12 +930,26 @@ export async function runBench(argv: string[]): Promise<number> {
           useNs,
         });
         const rate = r.timers[0]?.desiredRate;
-        if (useNs && rate !== undefined && rate > 0 && !r.timers[0]!.name.startsWith("(")) {
-          progress(`${def.id}: wake-up floor, a bare worker sleeping at ${rate} Hz`);
-          r.wakeFloorPct = round(await measureWakeFloor(rate, quick ? 3 : 10));
+        if (useNs && rate !== undefined && rate > 0 && !def.neighbour) {
+          const hz = wakeRate(rate, r.batchingMs);
+          progress(
+            `${def.id}: wake-up floor, a bare worker sleeping at ${hz.toFixed(1)} Hz (${rate} Hz ticks, batching ${r.batchingMs} ms)`,
+          );
+          r.wakeFloorHz = round(hz, 2);
+          r.wakeFloorPct = round(await measureWakeFloor(hz, quick ? 3 : 10));
         }
         results.push(r);
         for (const l of pipelineMarkdown(r, "##")) out(l);
+      } else if (def.kind === "batching") {
+        const r = await runBatching(def, {
+          cli,
+          root,
+          warmup,
+          steady: Math.max(2, Math.ceil(steady / 2)),
+          useNs,
+        });
+        results.push(r);
+        for (const l of batchingMarkdown(r, "##")) out(l);
       } else if (def.kind === "learn") {
         const r = await runLearn(def, { quick });
         results.push(r);
@@ -857,6 +1080,7 @@ function markdown(
   const rs = results.filter((r): r is ReplayResult => r.kind === "replay");
   if (rs.length) lines.push(...replayMarkdown(rs, "##"));
   for (const r of results) if (r.kind === "learn") lines.push(...learnMarkdown(r, "##"));
+  for (const r of results) if (r.kind === "batching") lines.push(...batchingMarkdown(r, "##"));
   for (const r of results) {
     if (r.kind !== "udp") continue;
     lines.push(`## ${r.title}`, "", r.ok ? udpLatencyLine(r) : `**Failed:** ${r.error}`, "");
