@@ -187,13 +187,22 @@ describe("StatusHistory", () => {
   it("keeps the last minute of statuses and summarises it", () => {
     const h = new StatusHistory(60);
     for (let i = 0; i < 1500; i++) {
-      h.push(i * 0.05, i < 1400 ? "ontime" : "lagging", 100, 0.1, i === 1499 ? 2 : 0.2);
+      h.push(
+        i * 0.05,
+        i < 1400 ? "ontime" : "lagging",
+        100,
+        0.1,
+        i === 1499 ? 2 : 0.2,
+        // A late batch a minute and a half ago (forgotten) and one 10 s ago.
+        i === 100 ? 90 : i === 1300 ? 30 : 1.5,
+      );
     }
     expect(h.count).toBe(1200);
     const s = h.summary();
     expect(s.fraction.lagging).toBeCloseTo(100 / 1200, 3);
     expect(s.fraction.ontime).toBeCloseTo(1100 / 1200, 3);
     expect(s.computeMaxMs).toBe(2);
+    expect(s.delayMaxMs).toBe(30);
     expect(h.newestT).toBeCloseTo(1499 * 0.05, 6);
     const seen: string[] = [];
     h.forEach((_t, status) => seen.push(status));

@@ -1,6 +1,7 @@
 /**
- * The last minute of a block's telemetry (no DOM): status, rate and compute time per telemetry
- * message (20 Hz), in fixed rings — what the Status tab draws as a strip and summarises.
+ * The last minute of a block's telemetry (no DOM): status, rate, compute time and the largest
+ * delivery delay per telemetry message (20 Hz), in fixed rings — what the Status tab draws as a
+ * strip and curves and summarises.
  */
 import type { Status } from "../../engine/runtime/status";
 
@@ -15,6 +16,8 @@ export interface HistorySummary {
   rateMin: number;
   rateMax: number;
   rateMean: number;
+  /** Largest delivery delay of the history, ms. */
+  delayMaxMs: number;
   samples: number;
 }
 
@@ -25,6 +28,8 @@ export class StatusHistory {
   readonly rate: Float64Array;
   readonly computeMean: Float64Array;
   readonly computeMax: Float64Array;
+  /** Largest delivery delay of each telemetry window, ms. */
+  readonly delayMax: Float64Array;
   private head = 0;
   count = 0;
 
@@ -38,6 +43,7 @@ export class StatusHistory {
     this.rate = new Float64Array(this.cap);
     this.computeMean = new Float64Array(this.cap);
     this.computeMax = new Float64Array(this.cap);
+    this.delayMax = new Float64Array(this.cap);
   }
 
   clear(): void {
@@ -45,7 +51,14 @@ export class StatusHistory {
     this.count = 0;
   }
 
-  push(t: number, status: Status, rate: number, computeMeanMs: number, computeMaxMs: number): void {
+  push(
+    t: number,
+    status: Status,
+    rate: number,
+    computeMeanMs: number,
+    computeMaxMs: number,
+    delayMaxMs = 0,
+  ): void {
     // A clock that went back (a new run) starts the history again.
     if (this.count && t < this.newestT - 1) this.clear();
     const i = this.head;
@@ -54,6 +67,7 @@ export class StatusHistory {
     this.rate[i] = rate;
     this.computeMean[i] = computeMeanMs;
     this.computeMax[i] = computeMaxMs;
+    this.delayMax[i] = delayMaxMs;
     this.head = (i + 1) % this.cap;
     if (this.count < this.cap) this.count++;
   }
@@ -70,6 +84,7 @@ export class StatusHistory {
       rate: number,
       computeMeanMs: number,
       computeMaxMs: number,
+      delayMaxMs: number,
     ) => void,
   ): void {
     const from = this.newestT - this.seconds;
@@ -83,6 +98,7 @@ export class StatusHistory {
         this.rate[i]!,
         this.computeMean[i]!,
         this.computeMax[i]!,
+        this.delayMax[i]!,
       );
     }
   }
@@ -95,7 +111,8 @@ export class StatusHistory {
     let rMin = Infinity;
     let rMax = -Infinity;
     let rSum = 0;
-    this.forEach((_t, s, rate, cm, cx) => {
+    let dMax = 0;
+    this.forEach((_t, s, rate, cm, cx, dx) => {
       counts[s]++;
       n++;
       cSum += cm;
@@ -103,6 +120,7 @@ export class StatusHistory {
       if (rate < rMin) rMin = rate;
       if (rate > rMax) rMax = rate;
       rSum += rate;
+      if (dx > dMax) dMax = dx;
     });
     const fraction = { ...counts };
     for (const s of STATUS_ORDER) fraction[s] = n ? counts[s] / n : 0;
@@ -113,6 +131,7 @@ export class StatusHistory {
       rateMin: n ? rMin : 0,
       rateMax: n ? rMax : 0,
       rateMean: n ? rSum / n : 0,
+      delayMaxMs: dMax,
       samples: n,
     };
   }

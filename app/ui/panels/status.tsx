@@ -1,14 +1,16 @@
 /**
  * Status tab: the last minute of the block's timing status as a strip of colours (with the word
  * and share of each status: colour is never the only signal), its actual rate against the
- * desired one, and its figures — compute time (mean / max), drops on its inputs, errors and the
- * last error, its status text and, for timers, ticks and lateness. The history is recorded from
- * telemetry (20 Hz) for as long as the panel exists, visible or not (telemetry flows anyway);
- * drawing happens only while the tab is shown.
+ * desired one, its delivery delay (the largest of each telemetry window against the delay that
+ * reads as late), and its figures — compute time (mean / max), delivery delay (p50 / p99 / max),
+ * drops on its inputs, errors and the last error, its status text and, for timers, ticks, the
+ * catch-up policy, the batching interval and lateness. The history is recorded from telemetry
+ * (20 Hz) for as long as the panel exists, visible or not (telemetry flows anyway); drawing
+ * happens only while the tab is shown.
  */
 import { useCallback, useEffect, useMemo, useRef, useState, type ReactNode } from "react";
 import type { BlockInfo } from "../../engine/protocol";
-import type { BlockTelemetry } from "../../engine/runtime/runtime";
+import type { BlockTelemetry, Telemetry } from "../../engine/runtime/runtime";
 import type { Status } from "../../engine/runtime/status";
 import { useEngine } from "../client/hooks";
 import { StatusIcon, STATUS_HELP, statusText } from "../graph/status";
@@ -20,6 +22,8 @@ import { STATUS_ORDER, StatusHistory } from "./status-history";
 export interface StatusRecorder {
   history: StatusHistory;
   latest: BlockTelemetry | undefined;
+  /** The pipeline's batching interval as its timers report it, ms (0 without timers). */
+  batchingMs: number;
   version: number;
 }
 
@@ -27,7 +31,7 @@ export interface StatusRecorder {
 export function useStatusRecorder(block: string): StatusRecorder {
   const client = useEngine();
   const rec = useMemo<StatusRecorder>(
-    () => ({ history: new StatusHistory(60), latest: undefined, version: 0 }),
+    () => ({ history: new StatusHistory(60), latest: undefined, batchingMs: 0, version: 0 }),
     [block],
   );
   useEffect(
@@ -36,12 +40,35 @@ export function useStatusRecorder(block: string): StatusRecorder {
         const b = t.blocks.find((x) => x.name === block);
         if (!b) return;
         rec.latest = b;
-        rec.history.push(t.t, b.status, b.rate, b.computeMeanMs, b.computeMaxMs);
+        rec.batchingMs = batchingOf(t);
+        rec.history.push(
+          t.t,
+          b.status,
+          b.rate,
+          b.computeMeanMs,
+          b.computeMaxMs,
+          b.delay.windowMaxMs,
+        );
         rec.version++;
       }),
     [client, block, rec],
   );
   return rec;
+}
+
+/** The largest batching interval the pipeline's timers report, ms. */
+function batchingOf(t: Telemetry): number {
+  let most = 0;
+  for (const b of t.blocks) if (b.timer && b.timer.batchingMs > most) most = b.timer.batchingMs;
+  return most;
+}
+
+/**
+ * The delivery delay above which a batch reads as late (the block turns lagging), ms: as the
+ * engine's status rule, max(2 periods, 20 ms) plus the batching interval.
+ */
+export function lateAfterMs(desiredRate: number, batchingMs: number): number {
+  return Math.max(desiredRate > 0 ? 2000 / desiredRate : 0, 20) + batchingMs;
 }
 
 const STATUS_FALLBACK: Record<Status, string> = {
@@ -51,8 +78,10 @@ const STATUS_FALLBACK: Record<Status, string> = {
   idle: "#8c8c8c",
 };
 const REFRESH_MS = 250;
-const HEIGHT = 132;
+const HEIGHT = 196;
 const STRIP_H = 22;
+/** Height of the delivery-delay band at the bottom of the history. */
+const DELAY_H = 52;
 
 export function StatusView({
   block,
@@ -71,7 +100,14 @@ export function StatusView({
   const draw = useCallback(() => {
     const c = canvas.current;
     if (c && width.current > 0)
-      drawHistory(c, width.current, HEIGHT, recorder.history, block.desiredRate);
+      drawHistory(
+        c,
+        width.current,
+        HEIGHT,
+        recorder.history,
+        block.desiredRate,
+        lateAfterMs(block.desiredRate, recorder.batchingMs),
+      );
   }, [recorder, block.desiredRate]);
   const onResize = useCallback(
     (w: number) => {
@@ -96,6 +132,7 @@ export function StatusView({
   const b = recorder.latest;
   const sum = recorder.history.summary();
   const status: Status = b?.status ?? "idle";
+  const late = lateAfterMs(block.desiredRate, recorder.batchingMs);
   return (
     <div className="mp-statusview" data-view="status" data-block={block.name}>
       <div className="mp-status-now">
@@ -112,7 +149,7 @@ export function StatusView({
         <canvas
           ref={canvas}
           role="img"
-          aria-label={`Status of ${block.name} over the last minute: ${STATUS_ORDER.map((s) => `${statusText(s, false)} ${Math.round(sum.fraction[s] * 100)} %`).join(", ")}`}
+          aria-label={`Status of ${block.name} over the last minute: ${STATUS_ORDER.map((s) => `${statusText(s, false)} ${Math.round(sum.fraction[s] * 100)} %`).join(", ")}; largest delivery delay ${delayMs(sum.delayMaxMs)}`}
         />
       </div>
       <ul className="mp-status-legend" aria-label="Share of the last minute">
@@ -135,6 +172,21 @@ export function StatusView({
             value={`mean ${ms(sum.computeMeanMs)}, max ${ms(sum.computeMaxMs)}`}
           />
           <Figure
+            term="Delivery delay"
+            value={
+              b.delay.n > 0
+                ? `p50 ${delayMs(b.delay.p50Ms)}, p99 ${delayMs(b.delay.p99Ms)}, max ${delayMs(b.delay.maxMs)}`
+                : "—"
+            }
+            title="Time of processing − timestamp of the oldest event of each batch"
+            warn={b.delay.p99Ms > late}
+          />
+          <Figure
+            term="Delivery delay (last minute)"
+            value={`max ${delayMs(sum.delayMaxMs)} (late above ${delayMs(late)})`}
+            warn={sum.delayMaxMs > late}
+          />
+          <Figure
             term="Period"
             value={block.desiredRate > 0 ? ms(1000 / block.desiredRate) : "—"}
           />
@@ -150,8 +202,22 @@ export function StatusView({
             <>
               <Figure
                 term="Ticks"
-                value={`${b.timer.fired} fired, ${b.timer.missed} missed${b.timer.running ? "" : " (stopped)"}`}
-                warn={b.timer.missed > 0}
+                value={
+                  b.timer.catchUp === "skip"
+                    ? `${b.timer.fired} fired, ${b.timer.missed} skipped${b.timer.running ? "" : " (stopped)"}`
+                    : `${b.timer.fired} fired, none lost${b.timer.running ? "" : " (stopped)"}`
+                }
+                title={
+                  b.timer.catchUp === "skip"
+                    ? "CatchUp: skip — after a late wake-up only the newest due tick fires; the others are skipped"
+                    : "Lossless: every due tick fires, late ones together in one batch"
+                }
+                warn={b.timer.catchUp === "skip" && b.timer.missed > 0}
+              />
+              <Figure
+                term="Catch-up · batching"
+                value={`${b.timer.catchUp === "skip" ? "skip (newest tick only)" : "all ticks"} · ${b.timer.batchingMs > 0 ? delayMs(b.timer.batchingMs) : "none"}`}
+                title="Catch-up policy after a late wake-up; batching: the worker wakes at most once per this interval"
               />
               <Figure
                 term="Lateness"
@@ -173,15 +239,28 @@ export function StatusView({
   );
 }
 
-function Figure({ term, value, warn }: { term: string; value: string; warn?: boolean }): ReactNode {
+function Figure({
+  term,
+  value,
+  warn,
+  title,
+}: {
+  term: string;
+  value: string;
+  warn?: boolean;
+  title?: string;
+}): ReactNode {
   return (
-    <div className={`mp-figure${warn ? " mp-warn" : ""}`}>
+    <div className={`mp-figure${warn ? " mp-warn" : ""}`} title={title}>
       <dt>{term}</dt>
       <dd>{value}</dd>
     </div>
   );
 }
 
+/** A delay, to the precision that matters (2 significant digits). */
+const delayMs = (x: number): string =>
+  x >= 10 ? `${x.toFixed(0)} ms` : x >= 1 ? `${x.toFixed(1)} ms` : `${(x * 1000).toFixed(0)} µs`;
 const ms = (x: number): string =>
   x >= 100 ? `${x.toFixed(0)} ms` : x >= 1 ? `${x.toFixed(2)} ms` : `${(x * 1000).toFixed(0)} µs`;
 const formatHz = (x: number): string => (x > 0 ? `${formatValue(x)} Hz` : "— (event-driven)");
@@ -200,6 +279,7 @@ function drawHistory(
   height: number,
   h: StatusHistory,
   desired: number,
+  lateMs: number,
 ): void {
   const ctx = fitCanvas(canvas, width, height);
   if (!ctx) return;
@@ -230,7 +310,7 @@ function drawHistory(
   ctx.fillText("status", left - 4, STRIP_H / 2);
   // The rate.
   const top = STRIP_H + 8;
-  const bottom = height - 14;
+  const bottom = height - 14 - DELAY_H - 8;
   let seen = 0;
   h.forEach((_t, _s, rate) => {
     if (rate > seen) seen = rate;
@@ -280,9 +360,47 @@ function drawHistory(
     left + 4,
     top + 8,
   );
+  // The delivery delay: the largest of each telemetry window, as bars (red above late).
+  const dTop = height - 14 - DELAY_H;
+  const dBottom = height - 14;
+  let seenDelay = 0;
+  h.forEach((_t, _s, _r, _cm, _cx, d) => {
+    if (d > seenDelay) seenDelay = d;
+  });
+  // Late shows two thirds up; a stall far beyond it is clipped (and said so).
+  const maxDelay = Math.max(lateMs * 1.5, Math.min(seenDelay * 1.05, lateMs * 4));
+  const dClipped = seenDelay > maxDelay;
+  const dyOf = (d: number): number => Math.max(dTop, dBottom - (d / maxDelay) * (dBottom - dTop));
+  ctx.strokeStyle = theme.grid;
+  ctx.lineWidth = 1;
+  ctx.strokeRect(left + 0.5, dTop + 0.5, w, DELAY_H);
+  const barW = Math.max(1, w / (h.seconds * 20));
+  h.forEach((t, _s, _r, _cm, _cx, d) => {
+    if (!(d > 0)) return;
+    const y = dyOf(d);
+    ctx.fillStyle = d > lateMs ? colors.lagging : theme.accent;
+    ctx.fillRect(xOf(t) - barW, y, barW, dBottom - y);
+  });
+  ctx.setLineDash([4, 3]);
+  ctx.strokeStyle = colors.lagging;
+  ctx.beginPath();
+  ctx.moveTo(left, dyOf(lateMs));
+  ctx.lineTo(right, dyOf(lateMs));
+  ctx.stroke();
+  ctx.setLineDash([]);
+  ctx.fillStyle = theme.muted;
+  ctx.textAlign = "right";
+  ctx.fillText(String(Math.round(lateMs)), left - 4, dyOf(lateMs));
+  ctx.fillText("0", left - 4, dBottom);
+  ctx.textAlign = "left";
+  ctx.fillText(
+    `delivery delay, ms (largest per 50 ms; dashed: late)${dClipped ? `; up to ${formatValue(Math.round(seenDelay))} clipped` : ""}`,
+    left + 4,
+    dTop + 8,
+  );
   ctx.textAlign = "right";
   ctx.textBaseline = "top";
-  ctx.fillText("now", right, bottom + 2);
+  ctx.fillText("now", right, dBottom + 2);
   ctx.textAlign = "left";
-  ctx.fillText(`−${h.seconds} s`, left, bottom + 2);
+  ctx.fillText(`−${h.seconds} s`, left, dBottom + 2);
 }
