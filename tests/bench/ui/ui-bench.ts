@@ -5,9 +5,11 @@
  * scope's redraw rate (draws counted by the panels in `window.__mosaicPanelStats`), the page's
  * frame rate (requestAnimationFrame), how busy the main thread is (Chrome's TaskDuration over wall
  * time, CDP Performance.getMetrics) and the CPU time of Chromium's threads (Linux /proc: unlike
- * wall-clock figures, not inflated when other programs compete for the cores). Targets: no long
- * task over 50 ms in 30 s; every scope ≥ 30 redraws per second. Prints the figures and writes
- * bench/results/ui-latest.json and ui-latest.md.
+ * wall-clock figures, not inflated when other programs compete for the cores), and the engine's
+ * side from the telemetry the page receives: ticks lost (timers' missed ticks, edge drops), each
+ * block's share of time in each status and its delivery delay. Targets: no long task over 50 ms
+ * in 30 s; every scope ≥ 30 redraws per second; no tick lost; every block on time (green)
+ * throughout. Prints the figures and writes bench/results/ui-latest.json and ui-latest.md.
  *
  * Run: `npm run bench:ui` (= node scripts/build-ts.mjs && node scripts/build-web.mjs &&
  * node tests/bench/ui/run.mjs [options]; `npm run bench:ui -- --seconds 10` etc.). Options:
@@ -201,10 +203,85 @@ async function snapshot(page: Page): Promise<Snapshot> {
   return (await page.evaluate(SNAPSHOT)) as Snapshot;
 }
 
-const TELEMETRY = `(() => {
-  const t = window.mosaic?.client?.telemetry;
-  return t ? t.blocks.map((b) => ({ name: b.name, status: b.status, rate: b.rate, desiredRate: b.desiredRate, dropsIn: b.dropsIn, computeMaxMs: b.computeMaxMs, fired: b.timer?.fired, missed: b.timer?.missed })) : [];
+/**
+ * Installed once the page's engine client exists: every telemetry message the page receives,
+ * summed per block (status counts, the largest delivery delay of each telemetry window) and the
+ * longest gap between two messages. `__benchEngineReset()` starts the sums again (the
+ * measurement's start).
+ */
+const ENGINE_RECORDER = `(() => {
+  const client = window.mosaic && window.mosaic.client;
+  if (!client) return false;
+  if (window.__benchEngine) return true;
+  const rec = { messages: 0, maxGapMs: 0, last: 0, blocks: {} };
+  window.__benchEngine = rec;
+  window.__benchEngineReset = () => { rec.messages = 0; rec.maxGapMs = 0; rec.blocks = {}; };
+  client.onTelemetry((t) => {
+    const now = performance.now();
+    if (rec.last && rec.messages > 0) rec.maxGapMs = Math.max(rec.maxGapMs, now - rec.last);
+    rec.last = now;
+    rec.messages++;
+    for (const b of t.blocks) {
+      const r = (rec.blocks[b.name] ??= { ontime: 0, lagging: 0, stumbling: 0, idle: 0, windowMaxMs: 0, rateMin: Infinity, rateMax: 0 });
+      r[b.status] = (r[b.status] ?? 0) + 1;
+      const w = b.delay ? b.delay.windowMaxMs : 0;
+      if (w > r.windowMaxMs) r.windowMaxMs = w;
+      if (b.rate < r.rateMin) r.rateMin = b.rate;
+      if (b.rate > r.rateMax) r.rateMax = b.rate;
+    }
+  });
+  return true;
 })()`;
+
+interface BlockRecord {
+  ontime: number;
+  lagging: number;
+  stumbling: number;
+  idle: number;
+  windowMaxMs: number;
+  rateMin: number;
+  rateMax: number;
+}
+interface EngineRecord {
+  messages: number;
+  maxGapMs: number;
+  blocks: Record<string, BlockRecord>;
+}
+
+/** The latest telemetry's counters that the benchmark takes differences of. */
+interface EngineSnapshot {
+  t: number;
+  blocks: {
+    name: string;
+    status: string;
+    rate: number;
+    desiredRate: number;
+    dropsIn: number;
+    computeTotalMs: number;
+    delay: { p50Ms: number; p99Ms: number; maxMs: number; n: number } | undefined;
+    timer: { fired: number; missed: number; catchUp: string; batchingMs: number } | undefined;
+  }[];
+  edgeDrops: number;
+}
+
+const ENGINE_SNAPSHOT = `(() => {
+  const t = window.mosaic && window.mosaic.client && window.mosaic.client.telemetry;
+  if (!t) return { t: 0, blocks: [], edgeDrops: 0 };
+  return {
+    t: t.t,
+    blocks: t.blocks.map((b) => ({
+      name: b.name, status: b.status, rate: b.rate, desiredRate: b.desiredRate, dropsIn: b.dropsIn,
+      computeTotalMs: b.timing ? b.timing.computeTotalMs : 0,
+      delay: b.delay ? { p50Ms: b.delay.p50Ms, p99Ms: b.delay.p99Ms, maxMs: b.delay.maxMs, n: b.delay.n } : undefined,
+      timer: b.timer ? { fired: b.timer.fired, missed: b.timer.missed, catchUp: b.timer.catchUp, batchingMs: b.timer.batchingMs } : undefined,
+    })),
+    edgeDrops: t.edges.reduce((n, e) => n + e.dropped, 0),
+  };
+})()`;
+
+async function engineSnapshot(page: Page): Promise<EngineSnapshot> {
+  return (await page.evaluate(ENGINE_SNAPSHOT)) as EngineSnapshot;
+}
 
 async function openPanels(page: Page, o: Options, base: string): Promise<void> {
   if (o.mode === "harness") {
@@ -281,17 +358,48 @@ interface Figures {
     skippedPerSecond: number;
   }[];
   afterClose: { tasks: number; messagesInOneSecond: number } | undefined;
+  /**
+   * The engine side, from the telemetry the page received during the measurement: ticks lost
+   * (timers' missed ticks and drops on every edge, differences over the window), and per block
+   * the share of telemetry messages in each status, the delivery delay (p50/p99/max since the
+   * pipeline started: the engine's histogram, warm-up included; `windowMaxMs`: the largest of
+   * the measured window) and the blocks' compute time (% of one core).
+   */
   engine: {
-    name: string;
-    status: string;
-    rate: number;
-    desiredRate: number;
-    dropsIn: number;
-    /** Timers: ticks fired and missed (late ticks skipped) since the start. */
-    fired?: number;
-    missed?: number;
-  }[];
-  targets: { noLongTask: boolean; scopesAt30fps: boolean };
+    telemetryMessages: number;
+    /** Longest gap between two telemetry messages arriving on the page (20 Hz: 50 ms). */
+    maxGapMs: number;
+    ticksLost: { missed: number; edgeDrops: number };
+    /** Sum of the blocks' measured compute time over the window (% of one core). */
+    computePercent: number;
+    blocks: {
+      name: string;
+      status: string;
+      /** Share of the telemetry messages in each status (%). */
+      share: { ontime: number; lagging: number; stumbling: number; idle: number };
+      rate: number;
+      rateMin: number;
+      desiredRate: number;
+      delayP50Ms: number;
+      delayP99Ms: number;
+      delayMaxMs: number;
+      windowMaxMs: number;
+      computePercent: number;
+      dropsIn: number;
+      /** Timers: ticks fired per second over the window, missed ticks, catch-up, batching. */
+      firedPerSecond?: number;
+      missed?: number;
+      catchUp?: string;
+      batchingMs?: number;
+    }[];
+  };
+  targets: {
+    noLongTask: boolean;
+    scopesAt30fps: boolean;
+    noTickLost: boolean;
+    /** Every block on time (green) in every telemetry message of the window. */
+    allOnTime: boolean;
+  };
 }
 
 /**
@@ -367,6 +475,10 @@ async function measure(page: Page, o: Options): Promise<Figures> {
   const cdp = await page.context().newCDPSession(page);
   await cdp.send("Performance.enable", { timeDomain: "timeTicks" });
   await page.waitForTimeout(o.warmup * 1000);
+  if (!(await page.evaluate(ENGINE_RECORDER)))
+    throw new Error("the page has no window.mosaic.client: cannot read the engine's telemetry");
+  await page.evaluate("window.__benchEngineReset()");
+  const e0 = await engineSnapshot(page);
   const m0 = await metrics(cdp);
   const c0 = cpuTimes();
   const start = await snapshot(page);
@@ -385,6 +497,8 @@ async function measure(page: Page, o: Options): Promise<Figures> {
   const end = prev;
   const m1 = await metrics(cdp);
   const c1 = cpuTimes();
+  const e1 = await engineSnapshot(page);
+  const rec = (await page.evaluate("window.__benchEngine")) as EngineRecord;
   const elapsed = (end.now - start.now) / 1000;
   const wall = (m1.Timestamp ?? 0) - (m0.Timestamp ?? 0) || elapsed;
   const share = (k: string): number => round((100 * ((m1[k] ?? 0) - (m0[k] ?? 0))) / wall, 1);
@@ -420,7 +534,7 @@ async function measure(page: Page, o: Options): Promise<Figures> {
         skippedPerSecond: round((v.skipped - a.skipped) / elapsed, 0),
       };
     });
-  const engine = (await page.evaluate(TELEMETRY)) as Figures["engine"];
+  const engine = engineFigures(e0, e1, rec);
   const sharedMemory = (await page.evaluate("self.crossOriginIsolated === true")) as boolean;
   const longest = tasks.reduce((m, t) => Math.max(m, t.duration), 0);
   return {
@@ -470,7 +584,69 @@ async function measure(page: Page, o: Options): Promise<Figures> {
       noLongTask: tasks.length === 0,
       scopesAt30fps:
         scopes.length === o.blocks.length && scopes.every((s) => s.redrawsPerSecond >= 30),
+      noTickLost:
+        engine.blocks.length > 0 &&
+        engine.ticksLost.missed === 0 &&
+        engine.ticksLost.edgeDrops === 0,
+      allOnTime:
+        engine.telemetryMessages > 0 &&
+        engine.blocks.length > 0 &&
+        engine.blocks.every((b) => b.share.ontime === 100),
     },
+  };
+}
+
+/** The engine's figures over the window: differences of two snapshots and the page's sums. */
+function engineFigures(
+  e0: EngineSnapshot,
+  e1: EngineSnapshot,
+  rec: EngineRecord,
+): Figures["engine"] {
+  const dt = e1.t - e0.t;
+  let missed = 0;
+  let computeMs = 0;
+  const blocks = e1.blocks.map((b) => {
+    const a = e0.blocks.find((x) => x.name === b.name);
+    const r = rec.blocks[b.name];
+    const n = r ? r.ontime + r.lagging + r.stumbling + r.idle : 0;
+    const pct = (k: number): number => (n ? round((100 * k) / n, 1) : 0);
+    const compute = b.computeTotalMs - (a?.computeTotalMs ?? 0);
+    computeMs += compute;
+    const out: Figures["engine"]["blocks"][number] = {
+      name: b.name,
+      status: b.status,
+      share: {
+        ontime: pct(r?.ontime ?? 0),
+        lagging: pct(r?.lagging ?? 0),
+        stumbling: pct(r?.stumbling ?? 0),
+        idle: pct(r?.idle ?? 0),
+      },
+      rate: round(b.rate, 1),
+      rateMin: round(r && Number.isFinite(r.rateMin) ? r.rateMin : 0, 1),
+      desiredRate: round(b.desiredRate, 3),
+      delayP50Ms: round(b.delay?.p50Ms ?? 0, 2),
+      delayP99Ms: round(b.delay?.p99Ms ?? 0, 2),
+      delayMaxMs: round(b.delay?.maxMs ?? 0, 2),
+      windowMaxMs: round(r?.windowMaxMs ?? 0, 2),
+      computePercent: round(dt > 0 ? compute / (10 * dt) : 0, 2),
+      dropsIn: b.dropsIn - (a?.dropsIn ?? 0),
+    };
+    if (b.timer) {
+      const m = b.timer.missed - (a?.timer?.missed ?? 0);
+      missed += m;
+      out.firedPerSecond = round(dt > 0 ? (b.timer.fired - (a?.timer?.fired ?? 0)) / dt : 0, 1);
+      out.missed = m;
+      out.catchUp = b.timer.catchUp;
+      out.batchingMs = b.timer.batchingMs;
+    }
+    return out;
+  });
+  return {
+    telemetryMessages: rec.messages,
+    maxGapMs: round(rec.maxGapMs, 0),
+    ticksLost: { missed, edgeDrops: e1.edgeDrops - e0.edgeDrops },
+    computePercent: round(dt > 0 ? computeMs / (10 * dt) : 0, 2),
+    blocks,
   };
 }
 
@@ -589,6 +765,9 @@ function markdown(f: Figures): string {
     `| main thread busy | — | ${f.mainThread.busyPercent} % (script ${f.mainThread.scriptPercent} %, style ${f.mainThread.stylePercent} %, layout ${f.mainThread.layoutPercent} %, paint and other ${f.mainThread.otherPercent} %) | — |`,
     `| main thread CPU | — | ${f.cpuPercent["renderer/main"] ?? "?"} % of a core (the engine's worker ${f.cpuPercent["renderer/DedicatedWorker"] ?? "?"} %) | — |`,
     `| page frames/s (requestAnimationFrame) | — | ${f.frames.perSecond} (panels' draw loop ${f.frames.panelLoopPerSecond}) | — |`,
+    `| engine: ticks lost (timers' missed ticks + edge drops) | 0 | ${f.engine.ticksLost.missed} + ${f.engine.ticksLost.edgeDrops} | ${yes(f.targets.noTickLost)} |`,
+    `| engine: blocks on time (green) | every block, every telemetry | ${f.engine.blocks.filter((b) => b.share.ontime === 100).length} of ${f.engine.blocks.length} always; least ${Math.min(...f.engine.blocks.map((b) => b.share.ontime))} % | ${yes(f.targets.allOnTime)} |`,
+    `| engine: delivery delay p99 (largest block) | — | ${Math.max(0, ...f.engine.blocks.map((b) => b.delayP99Ms))} ms since start; largest in the window ${Math.max(0, ...f.engine.blocks.map((b) => b.windowMaxMs))} ms | — |`,
     "",
     ...(f.longFrames.length
       ? [
@@ -623,16 +802,30 @@ function markdown(f: Figures): string {
       ? `After closing the panels: ${f.afterClose.tasks} draw tasks left, ${f.afterClose.messagesInOneSecond} data messages in the next second.`
       : "",
     "",
-    "Engine at the end: " +
-      f.engine
-        .map(
-          (b) =>
-            `${b.name} ${b.status} ${round(b.rate, 1)}/${round(b.desiredRate, 1)} Hz${b.dropsIn ? `, ${b.dropsIn} dropped` : ""}${b.fired !== undefined ? ` (${b.fired} ticks, ${b.missed ?? 0} missed)` : ""}`,
-        )
-        .join("; "),
+    ...engineLines(f),
     "",
   ];
   return lines.join("\n");
+}
+
+/** The engine's section: one row per block. */
+function engineLines(f: Figures): string[] {
+  const e = f.engine;
+  return [
+    `Engine (${e.telemetryMessages} telemetry messages received in the window, longest gap ${e.maxGapMs} ms; blocks' compute ${e.computePercent} % of a core). Status shares are of the telemetry messages; the delay is the engine's delivery delay (processing time − the oldest event's timestamp of each batch), p50/p99/max since the pipeline started, and the largest of the measured window:`,
+    "",
+    "| block | on time | lagging | stumbling | idle | rate (min) / desired, Hz | delay p50 / p99 / max, ms | window max, ms | compute, % core | lost |",
+    "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+    ...e.blocks.map(
+      (b) =>
+        `| ${b.name} | ${b.share.ontime} % | ${b.share.lagging} % | ${b.share.stumbling} % | ${b.share.idle} % | ${b.rate} (${b.rateMin}) / ${b.desiredRate} | ${b.delayP50Ms} / ${b.delayP99Ms} / ${b.delayMaxMs} | ${b.windowMaxMs} | ${b.computePercent} | ${
+          b.firedPerSecond !== undefined
+            ? `${b.missed ?? 0} missed of ${b.firedPerSecond}/s (catch-up ${b.catchUp}, batching ${b.batchingMs} ms)`
+            : ""
+        }${b.dropsIn ? `${b.firedPerSecond !== undefined ? ", " : ""}${b.dropsIn} dropped in` : ""} |`,
+    ),
+    "",
+  ];
 }
 
 async function main(): Promise<void> {
