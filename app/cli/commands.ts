@@ -263,10 +263,10 @@ async function cmdRun(args: string[]): Promise<number> {
       ...(mode === "virtual" && duration !== undefined ? { virtualDuration: duration } : {}),
     },
     {
-      telemetry: (t) => {
-        latest = t;
-        if (json) out(JSON.stringify({ type: "telemetry", ...t }));
-      },
+      // Only what is used: the JSON lines (printed as the workers encoded them), or the objects
+      // for the live table on a terminal.
+      ...(json ? { telemetryLine: (line: string) => out(line) } : {}),
+      ...(tty ? { telemetry: (t: Telemetry) => (latest = t) } : {}),
       event: (e) => {
         if (e.level === "error") blockErrors++;
         if (json) out(JSON.stringify({ type: "event", ...e }));

@@ -13,7 +13,7 @@ import { errorMessage } from "../engine/diagnostics";
 import type { Frame, Shape } from "../engine/frame";
 import { loadPipeline } from "../engine/pipeline/loader";
 import type { LogChannel, LogSink } from "../engine/runtime/logsink";
-import { Runtime } from "../engine/runtime/runtime";
+import { Runtime, type Telemetry } from "../engine/runtime/runtime";
 import { SabRing } from "../engine/runtime/sab-ring";
 import { runVirtual } from "../engine/runtime/virtual";
 import { RealtimeLoop } from "../engine/runtime/loop";
@@ -24,7 +24,7 @@ import { nodeUdpBridge } from "../../native-bridges/udp";
 import { createPythonBridge } from "../../native-bridges/python";
 import { flushWrites, nodeResources } from "./resources";
 import { clockFromBase } from "./time-base";
-import type { HostToWorker, InitMessage, WorkerToHost } from "./worker-protocol";
+import type { HostToWorker, InitMessage, TelemetryReport, WorkerToHost } from "./worker-protocol";
 
 const port = parentPort;
 if (!port) throw new Error("engine.worker must run in a worker thread");
@@ -125,6 +125,18 @@ async function create(msg: InitMessage): Promise<void> {
   post({ type: "created", plan: created.plan, diagnostics, doorbell: doorbellSab });
 }
 
+/** Telemetry with its blocks and edges encoded once, here (see TelemetryReport). */
+function report(t: Telemetry): TelemetryReport {
+  return {
+    t: t.t,
+    worker: t.worker,
+    blocks: JSON.stringify(t.blocks),
+    edges: JSON.stringify(t.edges),
+    events: t.events,
+    finished: t.finished,
+  };
+}
+
 function link(msg: Extract<HostToWorker, { type: "link" }>): void {
   if (!rt) return;
   for (const o of msg.outs) {
@@ -156,7 +168,7 @@ function start(): void {
       const r = runVirtual(runtime, clock, until, 20);
       if (performance.now() - lastTel >= telemetryIntervalS * 1000) {
         lastTel = performance.now();
-        post({ type: "telemetry", telemetry: runtime.telemetry() });
+        post({ type: "telemetry", report: report(runtime.telemetry()) });
       }
       if (r === "yield") setImmediate(chunk);
       else post({ type: "finished", telemetry: runtime.telemetry() });
@@ -171,7 +183,7 @@ function start(): void {
     doorbell,
     precision: init.precision,
     telemetryIntervalS,
-    onTelemetry: () => post({ type: "telemetry", telemetry: runtime.telemetry() }),
+    onTelemetry: () => post({ type: "telemetry", report: report(runtime.telemetry()) }),
     onFinished: () => post({ type: "finished", telemetry: runtime.telemetry() }),
   });
   rt.onWake = () => loop?.wake();

@@ -16,7 +16,13 @@ import { serialHub } from "../../native-bridges/serial-proxy";
 import { bleHub } from "../../native-bridges/ble-proxy";
 import { LogWriter } from "./log-writer";
 import { takeTimeBase } from "./time-base";
-import type { ClockMode, ControlOp, HostToWorker, WorkerToHost } from "./worker-protocol";
+import type {
+  ClockMode,
+  ControlOp,
+  HostToWorker,
+  TelemetryReport,
+  WorkerToHost,
+} from "./worker-protocol";
 
 export interface HostOptions {
   mode?: ClockMode;
@@ -38,7 +44,13 @@ export interface HostOptions {
 }
 
 export interface HostEvents {
+  /** Merged telemetry of all workers, as objects (parsed from the workers' reports on demand). */
   telemetry?: (t: Telemetry) => void;
+  /**
+   * The same as one JSON line, `{"type":"telemetry",…}` (what `mosaic run --json` prints), built
+   * from the workers' JSON text without parsing it.
+   */
+  telemetryLine?: (line: string) => void;
   event?: (e: RuntimeEvent) => void;
   finished?: () => void;
   fatal?: (message: string) => void;
@@ -91,6 +103,8 @@ interface WorkerState {
   name: string;
   worker: Worker;
   doorbell?: SharedArrayBuffer;
+  /** The latest telemetry as the worker sent it (JSON text), and as objects once parsed. */
+  report?: TelemetryReport;
   telemetry?: Telemetry;
   stopped: boolean;
   exited: boolean;
@@ -310,12 +324,19 @@ export class Host {
         this.logWriter.close(`${st.name}:${m.id}`);
         break;
       case "telemetry":
+        st.report = m.report;
+        st.telemetry = undefined;
+        for (const e of m.report.events) this.events.event?.(e);
+        m.report.events = [];
+        this.reportTelemetry();
+        break;
       case "finished":
       case "stopped":
+        st.report = undefined;
         st.telemetry = m.telemetry;
         for (const e of m.telemetry.events) this.events.event?.(e);
         m.telemetry.events = [];
-        this.events.telemetry?.(this.telemetry());
+        this.reportTelemetry();
         if (m.type === "finished") {
           this.finishedWorkers.add(st.name);
           if (st.name === "main" || this.finishedWorkers.size === this.workers.size)
@@ -393,10 +414,60 @@ export class Host {
     for (const w of this.workers.values()) this.post(w, { type: "start" } satisfies HostToWorker);
   }
 
+  private reportTelemetry(): void {
+    if (this.events.telemetry) this.events.telemetry(this.telemetry());
+    if (this.events.telemetryLine) this.events.telemetryLine(this.telemetryLine());
+  }
+
+  /** The telemetry of one worker as objects (its report parsed once). */
+  private workerTelemetry(w: WorkerState): Telemetry | undefined {
+    if (!w.telemetry && w.report) {
+      const r = w.report;
+      w.telemetry = {
+        t: r.t,
+        worker: r.worker,
+        blocks: JSON.parse(r.blocks) as Telemetry["blocks"],
+        edges: JSON.parse(r.edges) as Telemetry["edges"],
+        events: [],
+        finished: r.finished,
+      };
+    }
+    return w.telemetry;
+  }
+
+  /**
+   * Merged telemetry of all workers as one JSON line, exactly `JSON.stringify({ type:
+   * "telemetry", ...this.telemetry() })`, joined from the workers' JSON text.
+   */
+  telemetryLine(): string {
+    let t = 0;
+    let finished = true;
+    let any = false;
+    const blocks: string[] = [];
+    const edges: string[] = [];
+    for (const w of this.workers.values()) {
+      const r = w.report;
+      const o = r ? undefined : w.telemetry;
+      if (!r && !o) continue;
+      any = true;
+      t = Math.max(t, r ? r.t : o!.t);
+      finished &&= r ? r.finished : o!.finished;
+      const b = r ? r.blocks : JSON.stringify(o!.blocks);
+      const e = r ? r.edges : JSON.stringify(o!.edges);
+      if (b.length > 2) blocks.push(b.slice(1, -1));
+      if (e.length > 2) edges.push(e.slice(1, -1));
+    }
+    return (
+      `{"type":"telemetry","t":${JSON.stringify(t)},"worker":"*",` +
+      `"blocks":[${blocks.join(",")}],"edges":[${edges.join(",")}],` +
+      `"events":[],"finished":${String(any && finished)}}`
+    );
+  }
+
   /** Merged telemetry of all workers (latest of each). */
   telemetry(): Telemetry {
     const parts = [...this.workers.values()]
-      .map((w) => w.telemetry)
+      .map((w) => this.workerTelemetry(w))
       .filter((t): t is Telemetry => !!t);
     return {
       t: Math.max(0, ...parts.map((p) => p.t)),

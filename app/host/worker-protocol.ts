@@ -1,7 +1,7 @@
 /** Messages between the host (main thread) and its engine workers. */
 import type { Diagnostic } from "../engine/diagnostics";
 import type { Shape } from "../engine/frame";
-import type { Plan, Telemetry } from "../engine/runtime/runtime";
+import type { Plan, RuntimeEvent, Telemetry } from "../engine/runtime/runtime";
 import type { SabRingInit } from "../engine/runtime/sab-ring";
 import type { SerialReply, SerialRequest } from "../../native-bridges/serial-proxy";
 import type { BleReply, BleRequest } from "../../native-bridges/ble-proxy";
@@ -26,6 +26,22 @@ export interface InitMessage {
   telemetryHz: number;
   /** Batching interval for blocks without their own `BatchingMs`, s (the CLI's --batching-ms). */
   batchingS?: number;
+}
+
+/**
+ * Periodic telemetry with its blocks and edges as JSON text: the worker encodes it once, and the
+ * host prints it (`mosaic run --json`) or parses it only when someone needs the objects. Cheaper
+ * than a structured clone of the object graph decoded on the main thread 20 times a second.
+ */
+export interface TelemetryReport {
+  t: number;
+  worker: string;
+  /** JSON of `Telemetry.blocks`. */
+  blocks: string;
+  /** JSON of `Telemetry.edges`. */
+  edges: string;
+  events: RuntimeEvent[];
+  finished: boolean;
 }
 
 export interface LinkMessage {
@@ -62,7 +78,7 @@ export type WorkerToHost =
       ring: SabRingInit;
     }
   | { type: "log-close"; id: number }
-  | { type: "telemetry"; telemetry: Telemetry }
+  | { type: "telemetry"; report: TelemetryReport }
   | { type: "reply"; id: number; ok: boolean; message: string }
   | { type: "finished"; telemetry: Telemetry }
   | { type: "stopped"; telemetry: Telemetry }

@@ -22,8 +22,9 @@ function binOf(us: number): number {
   return LINEAR_US + octave * SUB + sub;
 }
 
-/** Upper edge of a bin, µs (what a quantile reports: never optimistic). */
+/** Upper edge of a bin, µs (what a quantile reports: never optimistic; the last bin is open). */
 function upperOf(bin: number): number {
+  if (bin === BINS - 1) return Infinity;
   if (bin < LINEAR_US) return bin + 1;
   const octave = Math.floor((bin - LINEAR_US) / SUB);
   const sub = (bin - LINEAR_US) % SUB;
@@ -36,6 +37,10 @@ export class DelayHistogram {
   count = 0;
   /** Largest delay recorded, s (exact, not binned). */
   max = 0;
+  /** `p50` and `p99` as of `summarized` delays (recomputed only when more were added). */
+  private p50s = NaN;
+  private p99s = NaN;
+  private summarized = 0;
 
   /** Records a delay of `s` seconds. */
   add(s: number): void {
@@ -57,9 +62,49 @@ export class DelayHistogram {
     return this.max;
   }
 
+  /** The median, s (NaN when empty); cached until more delays are added. */
+  get p50(): number {
+    this.summarize();
+    return this.p50s;
+  }
+
+  /** The 99th percentile, s (NaN when empty); cached until more delays are added. */
+  get p99(): number {
+    this.summarize();
+    return this.p99s;
+  }
+
   reset(): void {
     this.bins.fill(0);
     this.count = 0;
     this.max = 0;
+    this.p50s = NaN;
+    this.p99s = NaN;
+    this.summarized = 0;
+  }
+
+  /** Both quantiles in one pass over the bins. */
+  private summarize(): void {
+    if (this.summarized === this.count) return;
+    this.summarized = this.count;
+    const n = this.count;
+    const t50 = Math.max(1, Math.ceil(0.5 * n));
+    const t99 = Math.max(1, Math.ceil(0.99 * n));
+    let acc = 0;
+    let p50 = NaN;
+    const bins = this.bins;
+    for (let i = 0; i < BINS; i++) {
+      const c = bins[i]!;
+      if (c === 0) continue;
+      acc += c;
+      if (p50 !== p50 && acc >= t50) p50 = Math.min(upperOf(i) / 1e6, this.max);
+      if (acc >= t99) {
+        this.p50s = p50;
+        this.p99s = Math.min(upperOf(i) / 1e6, this.max);
+        return;
+      }
+    }
+    this.p50s = p50;
+    this.p99s = this.max;
   }
 }

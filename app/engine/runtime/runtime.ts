@@ -1122,8 +1122,8 @@ function delayFigures(s: StatusTracker): BlockTelemetry["delay"] {
   const h = s.delay;
   const ms = (x: number): number => (Number.isFinite(x) ? x * 1000 : 0);
   return {
-    p50Ms: ms(h.quantile(0.5)),
-    p99Ms: ms(h.quantile(0.99)),
+    p50Ms: ms(h.p50),
+    p99Ms: ms(h.p99),
     maxMs: ms(h.max),
     windowMaxMs: ms(s.delayMaxWindow),
     n: h.count,
