@@ -17,7 +17,8 @@
  * [data-block]; harness: the panels alone, see harness.tsx), --seconds 30, --warmup 5,
  * --pipeline pipelines/bench/delsys.yaml, --blocks Delsys,LowPass,Resampler (--blocks "" opens
  * none: the cost of the graph alone), --shots DIR (screenshots of every tab of every panel),
- * --trace FILE (a 5 s Chrome trace and a summary of the main thread's work), --no-write.
+ * --trace FILE (a 5 s Chrome trace and a summary of the main thread's work), --no-isolation
+ * (served without COOP/COEP: no shared memory, the engine on its coarse loop), --no-write.
  */
 import {
   createReadStream,
@@ -47,6 +48,8 @@ interface Options {
   /** A Chrome trace of 5 s after the measurement, with a summary of the main thread's work. */
   trace: string | undefined;
   write: boolean;
+  /** Serve with COOP/COEP (cross-origin isolated: shared memory, the precise loop). */
+  isolated: boolean;
   chromium: string;
 }
 
@@ -60,6 +63,7 @@ function parseArgs(argv: string[]): Options {
     shots: undefined,
     trace: undefined,
     write: true,
+    isolated: true,
     chromium: process.env.CHROMIUM ?? "/usr/bin/chromium",
   };
   for (let i = 0; i < argv.length; i++) {
@@ -80,6 +84,7 @@ function parseArgs(argv: string[]): Options {
     else if (a === "--shots") o.shots = resolve(next());
     else if (a === "--trace") o.trace = resolve(next());
     else if (a === "--no-write") o.write = false;
+    else if (a === "--no-isolation") o.isolated = false;
     else if (a === "--chromium") o.chromium = next();
     else throw new Error(`unknown option ${a}`);
   }
@@ -104,8 +109,11 @@ function inside(base: string, rel: string): string | undefined {
   return f.startsWith(base + sep) && existsSync(f) && statSync(f).isFile() ? f : undefined;
 }
 
-/** A static server for the browser build, cross-origin isolated (COOP/COEP) like `npm start`. */
-function serve(): Promise<{ server: Server; url: string }> {
+/**
+ * A static server for the browser build, cross-origin isolated (COOP/COEP) like `npm start`, or
+ * not (`isolated` false: a plain static host, where the engine falls back to its coarse loop).
+ */
+function serve(isolated: boolean): Promise<{ server: Server; url: string }> {
   const server = createServer((req, res) => {
     const path = decodeURIComponent(new URL(req.url ?? "/", "http://x").pathname);
     const rel = normalize(path === "/" ? "/index.html" : path).replace(/^([/\\])+/, "");
@@ -116,8 +124,12 @@ function serve(): Promise<{ server: Server; url: string }> {
     }
     res.writeHead(200, {
       "Content-Type": MIME[extname(file)] ?? "application/octet-stream",
-      "Cross-Origin-Opener-Policy": "same-origin",
-      "Cross-Origin-Embedder-Policy": "require-corp",
+      ...(isolated
+        ? {
+            "Cross-Origin-Opener-Policy": "same-origin",
+            "Cross-Origin-Embedder-Policy": "require-corp",
+          }
+        : {}),
       "Cache-Control": "no-store",
     });
     createReadStream(file).pipe(res);
@@ -836,7 +848,7 @@ async function main(): Promise<void> {
     throw new Error(
       "dist/bench-ui is missing: run node tests/bench/ui/run.mjs (it builds the harness)",
     );
-  const { server, url } = await serve();
+  const { server, url } = await serve(o.isolated);
   let browser: Browser | undefined;
   try {
     browser = await chromium.launch({
