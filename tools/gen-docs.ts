@@ -240,7 +240,7 @@ function pipelineSchema(blocks: readonly AnyBlockDefinition[]): JsonSchema {
 
 const BATCHING_MS: JsonSchema = {
   description:
-    "How long a timer's ticks may wait to go out together, in ms (DESIGN.md §3): the worker wakes at most once per interval and fires every tick due, as a device delivers packets. 0 wakes for every tick. In `Pipeline:` the default for every block (2 ms when unset); on a block, that block's own.",
+    "How long a timer's ticks may wait to go out together, in ms (DESIGN.md §3): the worker wakes at most once per interval and fires every tick due, as a device delivers packets. 0 wakes for every tick. In `Pipeline:` the default for every block (5 ms when unset); on a block, that block's own.",
   type: "number",
   minimum: 0,
   maximum: 1000,

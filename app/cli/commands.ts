@@ -41,7 +41,7 @@ Usage:
         --clock        realtime (default) or virtual (as fast as possible, deterministic)
         --precision    spin the last ~0.3 ms before each tick (less jitter, more CPU)
         --batching-ms MS  how long timer ticks may wait to go out together (default: the
-                       file's Pipeline: { BatchingMs }, else 2); 0 wakes for every tick.
+                       file's Pipeline: { BatchingMs }, else 5); 0 wakes for every tick.
                        Blocks with their own BatchingMs keep it.
         --log-dir DIR  base folder for relative Path logs (default: the pipeline's folder)
         --start T      virtual clock start time, UNIX seconds (default 0)

@@ -10,7 +10,7 @@ export const ScheduledTimer = defineBlock({
     "high-resolution clock and is stamped with that deadline. It never loses a tick: when its " +
     "worker wakes, every tick due since the last one goes out as one frame of n events, the way " +
     "a device delivers a packet of samples. The worker wakes at most once per batching interval " +
-    "(`BatchingMs`, default 2 ms; 0 wakes for every tick). `CatchUp: skip` is for control-rate " +
+    "(`BatchingMs`, default 5 ms; 0 wakes for every tick). `CatchUp: skip` is for control-rate " +
     "timers whose stale ticks are worthless: after a stall only the newest tick goes out and " +
     "the others are counted as missed. Ticks carry no values. Right-click actions start and stop " +
     "it; with `Autostart: false` it waits for the start action.",

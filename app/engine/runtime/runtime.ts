@@ -131,10 +131,16 @@ export interface Plan {
 const DEFAULT_QUEUE_MIN = 64;
 /**
  * The default batching interval (DESIGN.md §3): a worker wakes at most once per interval and
- * fires every tick due, as devices deliver packets. Measured on the 2-core bench machine
- * (bench/README.md): 1926 Hz at 0 / 1 / 2 ms …
+ * fires every tick due, as devices deliver packets. Chosen from `mosaic bench --only batching`
+ * on the 2-core bench machine (bench/README.md, "Batching sweep"): a wake-up costs far more than
+ * the work it triggers there, so CPU falls with the wake-up rate — the Delsys pipeline (1926 Hz)
+ * wakes 1828 / 836 / 474 / 196 / 97 times a second at 0 / 1 / 2 / 5 / 10 ms, and the Myo
+ * pipeline (200 Hz) only drops below one wake-up per sample from 5 ms (two samples a wake-up, as
+ * the armband's notifications carry). 5 ms is the knee: both pipelines at about 60 % of their 2 ms
+ * CPU, delivery delay p99 within 6 ms — below every device's own packet interval (Trigno 13.5 ms,
+ * Myo 10 ms) and far below the ~100 ms a myoelectric control loop tolerates.
  */
-export const DEFAULT_BATCHING_S = 0.002;
+export const DEFAULT_BATCHING_S = 0.005;
 const WARN_INTERVAL_S = 2;
 
 export interface RemoteSender {
