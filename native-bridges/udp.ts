@@ -139,18 +139,17 @@ class NodeUdpSocket implements UdpSocketHandle {
     });
   }
 
-  private readonly afterSend = (err: Error | null): void => {
-    if (err && !this.closed)
-      this.o.onError(describeUdpError(err, "send", this.o.remote ?? { host: "?", port: 0 }));
-  };
-
   private readonly pending: Buffer[] = [];
   private overflow = 0;
 
+  /**
+   * Sends without a completion callback: Node then tries the send at once and reports a failure
+   * as the socket's 'error' event (handled above), instead of scheduling a callback per datagram.
+   */
   private sendNow(buf: Buffer, to?: Endpoint): void {
     try {
-      if (to) this.socket.send(buf, to.port, to.host, this.afterSend);
-      else this.socket.send(buf, this.afterSend);
+      if (to) this.socket.send(buf, to.port, to.host);
+      else this.socket.send(buf);
     } catch (e) {
       this.o.onError(describeUdpError(e, "send", to ?? this.o.remote ?? { host: "?", port: 0 }));
     }
