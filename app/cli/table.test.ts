@@ -16,7 +16,7 @@ const block = (over: Partial<BlockTelemetry>): BlockTelemetry => ({
   computeMeanMs: 0.002,
   computeMaxMs: 0.004,
   latencyMs: 0,
-  delay: { p50Ms: 1.5, p99Ms: 1.7, maxMs: 3.2, windowMaxMs: 1.6, n: 50 },
+  delay: { p50Ms: 1.5, p99Ms: 1.7, maxMs: 3.2, windowMaxMs: 1.6, n: 50, lateMs: 55 },
   dropsIn: 0,
   text: "",
   errors: 0,
@@ -33,7 +33,10 @@ describe("mosaic run's live table", () => {
       worker: "*",
       blocks: [
         block({}),
-        block({ name: "Idle", delay: { p50Ms: 0, p99Ms: 0, maxMs: 0, windowMaxMs: 0, n: 0 } }),
+        block({
+          name: "Idle",
+          delay: { p50Ms: 0, p99Ms: 0, maxMs: 0, windowMaxMs: 0, n: 0, lateMs: 55 },
+        }),
       ],
       edges: [],
       events: [],

@@ -12,6 +12,8 @@ import { TextThrottle } from "../shared/text";
 import { parseDelimited, TIME_COLUMN_NAMES } from "./delimited-text";
 
 const columnRef = () => z.union([z.string().min(1), index()]);
+/** Most rows one wake-up of a self-timed player waits for (a batching interval rarely holds more). */
+const MAX_BATCH_ROWS = 65536;
 
 export const FilePlayer = defineBlock({
   type: "FilePlayer",
@@ -23,9 +25,10 @@ export const FilePlayer = defineBlock({
     "when the pipeline loads; a line that cannot be read is reported with its number and field. " +
     "With a timer input it emits one row per tick, stamped with the tick's time (the pace and " +
     "desired rate are the timer's). Without an input it plays the rows at their original timing: " +
-    "row i at start + (t_i − t_0)/Speed, stamped with that time; if the pipeline falls behind, " +
-    "every row that is due goes out in one frame (rows are never skipped), and its desired rate " +
-    "is Speed / (median row interval). At the end it starts again with `Loop: true` (the next " +
+    "row i at start + (t_i − t_0)/Speed, stamped with that time; the rows due within one " +
+    "batching interval (`BatchingMs`) go out together in one frame, as do all rows that are due " +
+    "when the pipeline falls behind (rows are never skipped), and its desired rate is " +
+    "Speed / (median row interval). At the end it starts again with `Loop: true` (the next " +
     "loop begins one median interval after the last row), otherwise it stops and reports that " +
     "it finished (a headless run ends when all its finite sources have). Empty lines and lines " +
     "starting with `#` are skipped; only the time column and the played columns must be " +
@@ -195,6 +198,30 @@ export const FilePlayer = defineBlock({
       return false;
     };
     const dueTime = (r: number, l: number): number => base + (times![r]! - t0 + l * span) / speed;
+    /**
+     * When to wake next: the due time of the last row within the batching interval of the next
+     * one (rows then go out together, as a device sends packets; DESIGN.md §3).
+     */
+    const nextWake = (): number => {
+      const first = dueTime(row, loops);
+      const batch = ctx.batching;
+      if (!(batch > 0)) return first;
+      let last = first;
+      let r = row;
+      let l = loops;
+      for (let k = 0; k < MAX_BATCH_ROWS; k++) {
+        r++;
+        if (r >= rows) {
+          if (!loop) break;
+          r = 0;
+          l++;
+        }
+        const d = dueTime(r, l);
+        if (d > first + batch) break;
+        last = d;
+      }
+      return last;
+    };
 
     const onTime = (t: number): void => {
       if (paused || done) return;
@@ -229,12 +256,12 @@ export const FilePlayer = defineBlock({
         return;
       }
       if (throttle.due(t)) describe();
-      ctx.at(dueTime(row, loops), onTime);
+      ctx.at(nextWake(), onTime);
     };
 
     const schedule = () => {
       if (timed || paused || done || !started) return;
-      ctx.at(dueTime(row, loops), onTime);
+      ctx.at(nextWake(), onTime);
     };
     const rewind = () => {
       row = 0;

@@ -19,6 +19,7 @@
 
 import {
   initSync,
+  set_simd_enabled,
   version,
   wasm_memory,
   WasmAdaptiveFilter,
@@ -79,6 +80,16 @@ export function initDsp(wasmBytes: DspWasmSource): void {
 /** `true` once `initDsp` has succeeded in this thread. */
 export function dspReady(): boolean {
   return memoryReady();
+}
+
+/**
+ * Chooses the kernels' SIMD128 paths (`true`, the default) or their scalar code (`false`) from
+ * now on; the two give the same bits (for tests that check it). Returns whether the module has
+ * SIMD paths at all (`scripts/build-wasm.sh` builds it with `+simd128`).
+ */
+export function setSimdEnabled(enabled: boolean): boolean {
+  requireReady("setSimdEnabled()");
+  return set_simd_enabled(enabled);
 }
 
 /** Version of the Rust core (`mosaic-core-wasm` crate). */

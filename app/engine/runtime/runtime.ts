@@ -53,7 +53,15 @@ export interface BlockTelemetry {
    * last `resetTiming`, and the largest since the previous telemetry. Real time only (0 under the
    * virtual clock). `n` counts batches.
    */
-  delay: { p50Ms: number; p99Ms: number; maxMs: number; windowMaxMs: number; n: number };
+  delay: {
+    p50Ms: number;
+    p99Ms: number;
+    maxMs: number;
+    windowMaxMs: number;
+    n: number;
+    /** A batch delayed longer than this is late: the block reads as lagging. */
+    lateMs: number;
+  };
   /** Events dropped on the edges into this block (all time). */
   dropsIn: number;
   text: string;
@@ -1133,5 +1141,6 @@ function delayFigures(s: StatusTracker): BlockTelemetry["delay"] {
     maxMs: ms(h.max),
     windowMaxMs: ms(s.delayMaxWindow),
     n: h.count,
+    lateMs: s.lateAfter() * 1000,
   };
 }

@@ -5,7 +5,7 @@
  *   which a batch is allowed to wait), or none at all;
  * - lagging (red) when rate < 95 % of DesiredRate, or when, within the current 100-output
  *   window, an input batch reached the block late: its oldest event waited longer than
- *   max(2 periods, 20 ms) plus the batching interval (the engine is behind real time; lossless
+ *   max(2 periods, 50 ms) plus the batching interval (the engine is behind real time; lossless
  *   timers keep rates exact, so a rate alone would not show it);
  * - stumbling (magenta) when one `process` call (measured) took longer than the time its events
  *   span, max(1, n) / DesiredRate, within the current window;
@@ -28,8 +28,12 @@ export const IDLE_PERIODS = 10;
 export const APERIODIC_IDLE_S = 1;
 /** A batch is late when its oldest event waited longer than this many periods … */
 export const LATE_PERIODS = 2;
-/** … or this long, whichever is more, plus the batching interval. */
-export const LATE_MIN_S = 0.02;
+/**
+ * … or this long, whichever is more, plus the batching interval. 50 ms: well inside the ~100 ms
+ * a myoelectric control loop tolerates (Farrell & Weir 2007), and above the hiccups (GC, a
+ * descheduled VM) that a busy machine has without the engine being behind.
+ */
+export const LATE_MIN_S = 0.05;
 
 export interface StatusEval {
   status: Status;
@@ -124,9 +128,13 @@ export class StatusTracker {
     const d = now - oldest;
     this.delay.add(d);
     if (d > this.delayMaxWindow) this.delayMaxWindow = d;
+    if (d > this.lateAfter()) this.lastLateWall = now;
+  }
+
+  /** The delivery delay above which a batch is late (the block reads as lagging), s. */
+  lateAfter(): number {
     const r = this.desiredRate;
-    const late = Math.max(r > 0 ? LATE_PERIODS / r : 0, LATE_MIN_S) + this.batchS;
-    if (d > late) this.lastLateWall = now;
+    return Math.max(r > 0 ? LATE_PERIODS / r : 0, LATE_MIN_S) + this.batchS;
   }
 
   /**

@@ -34,6 +34,14 @@ pub fn wasm_memory() -> JsValue {
     wasm_bindgen::memory()
 }
 
+/// Chooses the SIMD128 kernels (`true`, the default) or the scalar code
+/// (`false`) from now on, for tests that compare the two; returns whether
+/// this build has SIMD kernels at all (see `mosaic_dsp::set_simd_enabled`).
+#[wasm_bindgen]
+pub fn set_simd_enabled(enabled: bool) -> bool {
+    mosaic_dsp::set_simd_enabled(enabled)
+}
+
 /// The version of this crate.
 #[wasm_bindgen]
 pub fn version() -> String {

@@ -303,16 +303,38 @@ impl FeatureKernel {
         // is read from memory once and stays in L1 while every feature runs
         // over it with its accumulators in registers; every channel still sums
         // its samples in order (same bits as a plain loop over the channel).
+        // With SIMD128 a strip is BLOCK / 2 vectors of two channels (or one
+        // vector for the last pairs), with the same operations per channel.
         let acc = &mut self.acc;
+        let simd = crate::simd::simd_enabled();
         let mut c0 = 0;
         while c0 < c {
-            let width = if c0 + BLOCK <= c { BLOCK } else { 1 };
+            let left = c - c0;
+            let width = if left >= BLOCK {
+                BLOCK
+            } else if simd && left >= 2 {
+                2
+            } else {
+                1
+            };
             for (spec, a) in self.specs.iter().zip(acc.chunks_exact_mut(c)) {
+                let (f, t) = (spec.feature, spec.threshold);
+                let a = &mut a[c0..c0 + width];
+                #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+                if simd {
+                    if width == BLOCK {
+                        strip_simd::<{ BLOCK / 2 }>(w, c, c0, rows, f, t, a);
+                        continue;
+                    }
+                    if width == 2 {
+                        strip_simd::<1>(w, c, c0, rows, f, t, a);
+                        continue;
+                    }
+                }
                 if width == BLOCK {
-                    let s = strip::<BLOCK>(w, c, c0, rows, spec.feature, spec.threshold);
-                    a[c0..c0 + BLOCK].copy_from_slice(&s);
+                    a.copy_from_slice(&strip::<BLOCK>(w, c, c0, rows, f, t));
                 } else {
-                    a[c0] = strip::<1>(w, c, c0, rows, spec.feature, spec.threshold)[0];
+                    a[0] = strip::<1>(w, c, c0, rows, f, t)[0];
                 }
             }
             c0 += width;
@@ -447,6 +469,136 @@ fn strip<const B: usize>(
         }
     }
     acc
+}
+
+/// [`strip`] for channels `c0 .. c0 + 2·V` with SIMD128 (`V` vectors of two
+/// channels), written into `out`. Every channel goes through the same
+/// operations in the same order as in [`strip`] (sums in sample order), so the
+/// results are bit-identical; counts are kept as integers (exact either way).
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+#[inline(always)]
+fn strip_simd<const V: usize>(
+    w: &[f64],
+    c: usize,
+    c0: usize,
+    rows: usize,
+    feature: Feature,
+    t: f64,
+    out: &mut [f64],
+) {
+    use crate::simd::v::*;
+    let at = |r: usize| -> [v128; V] {
+        let i = r * c + c0;
+        let x = &w[i..i + 2 * V];
+        core::array::from_fn(|k| ld(x, 2 * k))
+    };
+    let zero = f64x2_splat(0.0);
+    let tv = f64x2_splat(t);
+    let mut acc = [zero; V];
+    // Counts: the sum of the comparison masks (−1 per hit).
+    let mut hits = [i64x2_splat(0); V];
+    let mut counts = false;
+    match feature {
+        Feature::Mav | Feature::Iav => {
+            for r in 0..rows {
+                let x = at(r);
+                for k in 0..V {
+                    acc[k] = f64x2_add(acc[k], f64x2_abs(x[k]));
+                }
+            }
+        }
+        Feature::Rms | Feature::Var => {
+            for r in 0..rows {
+                let x = at(r);
+                for k in 0..V {
+                    acc[k] = f64x2_add(acc[k], f64x2_mul(x[k], x[k]));
+                }
+            }
+        }
+        Feature::Wl => {
+            let mut p = at(0);
+            for r in 1..rows {
+                let x = at(r);
+                for k in 0..V {
+                    acc[k] = f64x2_add(acc[k], f64x2_abs(f64x2_sub(x[k], p[k])));
+                }
+                p = x;
+            }
+        }
+        Feature::Dasdv => {
+            let mut p = at(0);
+            for r in 1..rows {
+                let x = at(r);
+                for k in 0..V {
+                    let d = f64x2_sub(x[k], p[k]);
+                    acc[k] = f64x2_add(acc[k], f64x2_mul(d, d));
+                }
+                p = x;
+            }
+        }
+        Feature::Zc => {
+            counts = true;
+            let mut p = at(0);
+            for r in 1..rows {
+                let x = at(r);
+                for k in 0..V {
+                    let sign = f64x2_lt(f64x2_mul(p[k], x[k]), zero);
+                    let big = f64x2_ge(f64x2_abs(f64x2_sub(p[k], x[k])), tv);
+                    hits[k] = i64x2_add(hits[k], v128_and(sign, big));
+                }
+                p = x;
+            }
+        }
+        Feature::Wamp => {
+            counts = true;
+            let mut p = at(0);
+            for r in 1..rows {
+                let x = at(r);
+                for k in 0..V {
+                    let big = f64x2_ge(f64x2_abs(f64x2_sub(p[k], x[k])), tv);
+                    hits[k] = i64x2_add(hits[k], big);
+                }
+                p = x;
+            }
+        }
+        Feature::Ssc => {
+            counts = true;
+            let (mut b, mut m) = (at(0), at(1));
+            for r in 2..rows {
+                let x = at(r);
+                for k in 0..V {
+                    let prod = f64x2_mul(f64x2_sub(m[k], b[k]), f64x2_sub(m[k], x[k]));
+                    hits[k] = i64x2_add(hits[k], f64x2_ge(prod, tv));
+                }
+                b = m;
+                m = x;
+            }
+        }
+        Feature::SscMosaic => {
+            counts = true;
+            let (mut b, mut m) = (at(0), at(1));
+            for r in 2..rows {
+                let x = at(r);
+                for k in 0..V {
+                    let d1 = f64x2_sub(m[k], b[k]);
+                    let d2 = f64x2_sub(x[k], m[k]);
+                    let turn = f64x2_lt(f64x2_mul(d1, d2), zero);
+                    let big = v128_and(f64x2_ge(f64x2_abs(d1), tv), f64x2_ge(f64x2_abs(d2), tv));
+                    hits[k] = i64x2_add(hits[k], v128_and(turn, big));
+                }
+                b = m;
+                m = x;
+            }
+        }
+    }
+    for k in 0..V {
+        if counts {
+            out[2 * k] = -i64x2_extract_lane::<0>(hits[k]) as f64;
+            out[2 * k + 1] = -i64x2_extract_lane::<1>(hits[k]) as f64;
+        } else {
+            st(out, 2 * k, acc[k]);
+        }
+    }
 }
 
 #[cfg(test)]

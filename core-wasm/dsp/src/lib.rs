@@ -30,6 +30,9 @@
 //! * [`ArtifactRejector`] — the MOSAIC *ArtifactRejection* block: clipping,
 //!   flat line, jumps, drift per channel of a window.
 //!
+//! In the wasm build (`simd128`) the feature kernel and the synthesiser have
+//! SIMD paths, bit-identical to the scalar code ([`set_simd_enabled`]).
+//!
 //! ```
 //! use mosaic_dsp::{FilterBank, FunctionKernel, FunctionOp};
 //!
@@ -42,7 +45,8 @@
 //! assert_eq!(signal, [0.5, 1.0, 2.0, 3.0]);
 //! # Ok::<(), mosaic_dsp::DspError>(())
 //! ```
-#![forbid(unsafe_code)]
+// `unsafe` only in `simd` (v128 loads and stores of bounds-checked slices).
+#![deny(unsafe_code)]
 #![warn(missing_docs)]
 
 mod adaptive;
@@ -53,6 +57,7 @@ mod features;
 mod filter;
 mod function;
 pub mod rng;
+mod simd;
 mod synth;
 mod window;
 
@@ -62,6 +67,7 @@ pub use error::DspError;
 pub use features::{Feature, FeatureKernel, FeatureSpec};
 pub use filter::FilterBank;
 pub use function::{FunctionKernel, FunctionOp};
+pub use simd::{set_simd_enabled, simd_enabled, SIMD_COMPILED};
 pub use synth::{EmgSynth, EmgSynthConfig};
 pub use window::{SlidingWindow, WindowFunction, WindowedFeatures};
 

@@ -1,7 +1,7 @@
 use std::f64::consts::TAU;
 
 use crate::design::{butterworth_highpass2, butterworth_lowpass2, Biquad};
-use crate::rng::Rng;
+use crate::rng::{polar_pair, Rng};
 use crate::{check_multiple, DspError};
 
 /// Configuration of an [`EmgSynth`]. Build it with [`EmgSynthConfig::new`]
@@ -92,31 +92,42 @@ impl EmgSynthConfig {
     }
 }
 
-/// Per-channel state that `reset` restores.
+/// Per-channel state that `reset` restores, one value per channel in each
+/// field (side by side, so that the SIMD path loads two channels at once).
 #[derive(Debug, Clone)]
-struct Channel {
-    rng: Rng,
+struct State {
+    /// xoshiro256++ states: `rng[i][c]` is word `i` of channel `c`'s generator.
+    rng: [Vec<u64>; 4],
     /// Transposed direct form II states of the high-pass and low-pass.
-    hp: [f64; 2],
-    lp: [f64; 2],
-    env: f64,
-    /// Constant per-channel parameters drawn from the channel's generator:
-    /// the hum's phase as (sin ψ, cos ψ) so that the hum needs no `sin` per
-    /// channel, the modulation's phase and rate (cycles per sample).
-    hum_sin: f64,
-    hum_cos: f64,
-    mod_phase: f64,
-    mod_rate: f64,
-    /// sin/cos of one sample's modulation phase step (a rotation).
-    step_sin: f64,
-    step_cos: f64,
+    hp: [Vec<f64>; 2],
+    lp: [Vec<f64>; 2],
+    env: Vec<f64>,
     /// sin/cos of the modulation phase at the current sample: advanced by the
     /// rotation every sample, recomputed exactly every `RESYNC` samples (so
     /// rounding never accumulates and the output does not depend on how the
     /// samples are split into calls).
-    mod_sin: f64,
-    mod_cos: f64,
+    mod_sin: Vec<f64>,
+    mod_cos: Vec<f64>,
 }
+
+/// Constant per-channel parameters drawn from the channel's generator: the
+/// hum's phase as (sin ψ, cos ψ) so that the hum needs no `sin` per channel,
+/// the modulation's phase and rate (cycles per sample), and sin/cos of one
+/// sample's modulation phase step (a rotation).
+#[derive(Debug, Clone)]
+struct Constants {
+    hum_sin: Vec<f64>,
+    hum_cos: Vec<f64>,
+    mod_phase: Vec<f64>,
+    mod_rate: Vec<f64>,
+    step_sin: Vec<f64>,
+    step_cos: Vec<f64>,
+}
+
+/// Rows generated per block: the hum phasor of a block's rows is computed
+/// once for all channels, then every channel (pair) runs through the block
+/// with its state in registers.
+const BLOCK_ROWS: usize = 32;
 
 /// Samples between exact recomputations of the modulation phasor.
 const RESYNC: u64 = 1024;
@@ -176,8 +187,16 @@ pub struct EmgSynth {
     /// Hum frequency in cycles per sample.
     hum_rate: f64,
     targets: Vec<f64>,
-    channels: Vec<Channel>,
-    initial: Vec<Channel>,
+    consts: Constants,
+    state: State,
+    initial: State,
+    /// Scratch of the SIMD path: the white noise of a block (6 values per
+    /// channel pair and row).
+    #[cfg_attr(
+        not(all(target_arch = "wasm32", target_feature = "simd128")),
+        allow(dead_code)
+    )]
+    noise: Vec<f64>,
     /// Index of the next sample.
     n: u64,
 }
@@ -219,36 +238,54 @@ impl EmgSynth {
                 1.0
             }
         };
-        let initial: Vec<Channel> = (0..config.channels)
-            .map(|c| {
-                let mut rng = Rng::new(config.seed, c as u64);
-                let hum_phase = TAU * rng.uniform();
-                let mod_phase = TAU * rng.uniform();
-                let mod_hz = 1.0 + 2.0 * rng.uniform();
-                let mod_rate = mod_hz / fs;
-                Channel {
-                    rng,
-                    hp: [0.0; 2],
-                    lp: [0.0; 2],
-                    env: 0.0,
-                    hum_sin: hum_phase.sin(),
-                    hum_cos: hum_phase.cos(),
-                    mod_phase,
-                    mod_rate,
-                    step_sin: (TAU * mod_rate).sin(),
-                    step_cos: (TAU * mod_rate).cos(),
-                    mod_sin: mod_phase.sin(),
-                    mod_cos: mod_phase.cos(),
-                }
-            })
-            .collect();
+        let c = config.channels;
+        let mut initial = State {
+            rng: std::array::from_fn(|_| Vec::with_capacity(c)),
+            hp: [vec![0.0; c], vec![0.0; c]],
+            lp: [vec![0.0; c], vec![0.0; c]],
+            env: vec![0.0; c],
+            mod_sin: Vec::with_capacity(c),
+            mod_cos: Vec::with_capacity(c),
+        };
+        let mut consts = Constants {
+            hum_sin: Vec::with_capacity(c),
+            hum_cos: Vec::with_capacity(c),
+            mod_phase: Vec::with_capacity(c),
+            mod_rate: Vec::with_capacity(c),
+            step_sin: Vec::with_capacity(c),
+            step_cos: Vec::with_capacity(c),
+        };
+        for ch in 0..c {
+            let mut rng = Rng::new(config.seed, ch as u64);
+            let hum_phase = TAU * rng.uniform();
+            let mod_phase = TAU * rng.uniform();
+            let mod_hz = 1.0 + 2.0 * rng.uniform();
+            let mod_rate = mod_hz / fs;
+            for (word, value) in initial.rng.iter_mut().zip(rng.state()) {
+                word.push(value);
+            }
+            initial.mod_sin.push(mod_phase.sin());
+            initial.mod_cos.push(mod_phase.cos());
+            consts.hum_sin.push(hum_phase.sin());
+            consts.hum_cos.push(hum_phase.cos());
+            consts.mod_phase.push(mod_phase);
+            consts.mod_rate.push(mod_rate);
+            consts.step_sin.push((TAU * mod_rate).sin());
+            consts.step_cos.push((TAU * mod_rate).cos());
+        }
         Ok(EmgSynth {
             alpha_attack: alpha(config.attack_ms),
             alpha_release: alpha(config.release_ms),
             hum_rate: config.hum_hz / fs,
             targets: vec![0.0; config.channels],
-            channels: initial.clone(),
+            consts,
+            state: initial.clone(),
             initial,
+            noise: if crate::simd::SIMD_COMPILED {
+                vec![0.0; BLOCK_ROWS * c * 3]
+            } else {
+                Vec::new()
+            },
             hp,
             lp,
             emg_gain,
@@ -388,45 +425,190 @@ impl EmgSynth {
     pub fn generate(&mut self, out: &mut [f64]) -> Result<(), DspError> {
         let c = self.config.channels;
         check_multiple("output", out.len(), c)?;
-        let noise = self.config.noise_floor_mv;
-        let hum = self.config.hum_mv;
-        let depth = self.config.modulation;
-        for row in out.chunks_exact_mut(c) {
-            let t = self.n as f64;
-            let resync = self.n % RESYNC == 0;
+        let simd = crate::simd::simd_enabled();
+        for block in out.chunks_mut(BLOCK_ROWS * c) {
+            let rows = block.len() / c;
             // sin(a + ψ) = sin a · cos ψ + cos a · sin ψ: one sin/cos per sample for all channels.
-            let (hum_sin, hum_cos) = (TAU * fract(t * self.hum_rate)).sin_cos();
-            for ((y, ch), &target) in row.iter_mut().zip(&mut self.channels).zip(&self.targets) {
-                let w1 = ch.rng.gaussian();
-                let w2 = ch.rng.gaussian();
-                let mut band = w1;
-                if let Some(hp) = &self.hp {
-                    band = biquad(hp, &mut ch.hp, band);
-                }
-                band = biquad(&self.lp, &mut ch.lp, band);
-                let alpha = if target > ch.env {
-                    self.alpha_attack
-                } else {
-                    self.alpha_release
-                };
-                ch.env += alpha * (target - ch.env);
-                if resync {
-                    let (s, c) = (TAU * fract(t * ch.mod_rate) + ch.mod_phase).sin_cos();
-                    ch.mod_sin = s;
-                    ch.mod_cos = c;
-                }
-                let modulation = 1.0 + depth * ch.mod_sin;
-                *y = self.emg_gain * band * ch.env * modulation
-                    + noise * w2
-                    + hum * (hum_sin * ch.hum_cos + hum_cos * ch.hum_sin);
-                // Advance the modulation phasor by one sample.
-                let (s, c) = (ch.mod_sin, ch.mod_cos);
-                ch.mod_sin = s * ch.step_cos + c * ch.step_sin;
-                ch.mod_cos = c * ch.step_cos - s * ch.step_sin;
+            let mut hum = [(0.0, 0.0); BLOCK_ROWS];
+            for (r, h) in hum.iter_mut().take(rows).enumerate() {
+                let t = (self.n + r as u64) as f64;
+                *h = (TAU * fract(t * self.hum_rate)).sin_cos();
             }
-            self.n += 1;
+            let hum = &hum[..rows];
+            // The row (if any) at which the modulation phasors are recomputed.
+            let resync = (0..rows).find(|&r| (self.n + r as u64) % RESYNC == 0);
+            let mut ch = 0;
+            #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+            if simd && c >= 2 {
+                // The white noise of every channel pair and row first: drawing
+                // the points, then scaling them all in one long loop, keeps the
+                // long chains of the logarithm, division and square root of many
+                // rows in flight at once, even when a call has few rows.
+                let pairs = c / 2;
+                let mut noise = std::mem::take(&mut self.noise);
+                let noise_rows = &mut noise[..pairs * rows * 6];
+                for (p, out) in noise_rows.chunks_exact_mut(rows * 6).enumerate() {
+                    polar_points_simd(&mut self.state.rng, 2 * p, out);
+                }
+                polar_scale_simd(noise_rows);
+                for (p, w) in noise_rows.chunks_exact(rows * 6).enumerate() {
+                    self.pair_simd(2 * p, block, hum, resync, w);
+                }
+                self.noise = noise;
+                ch = 2 * pairs;
+            }
+            let _ = simd;
+            while ch < c {
+                self.channel_scalar(ch, block, hum, resync);
+                ch += 1;
+            }
+            self.n += rows as u64;
         }
         Ok(())
+    }
+
+    /// The exact modulation phasor (sin, cos) of channel `ch` at sample `n`.
+    fn modulation_at(&self, ch: usize, n: u64) -> (f64, f64) {
+        let t = n as f64;
+        (TAU * fract(t * self.consts.mod_rate[ch]) + self.consts.mod_phase[ch]).sin_cos()
+    }
+
+    /// Rows `0..hum.len()` of channel `ch` of a block of output rows
+    /// (starting at sample `self.n`).
+    fn channel_scalar(
+        &mut self,
+        ch: usize,
+        block: &mut [f64],
+        hum: &[(f64, f64)],
+        resync: Option<usize>,
+    ) {
+        let c = self.config.channels;
+        let noise = self.config.noise_floor_mv;
+        let hum_mv = self.config.hum_mv;
+        let depth = self.config.modulation;
+        let gain = self.emg_gain;
+        let target = self.targets[ch];
+        let (hum_cos_ch, hum_sin_ch) = (self.consts.hum_cos[ch], self.consts.hum_sin[ch]);
+        let (step_sin, step_cos) = (self.consts.step_sin[ch], self.consts.step_cos[ch]);
+        let resync = resync.map(|r| (r, self.modulation_at(ch, self.n + r as u64)));
+        let st = &mut self.state;
+        let mut rng = [st.rng[0][ch], st.rng[1][ch], st.rng[2][ch], st.rng[3][ch]];
+        let mut hp = [st.hp[0][ch], st.hp[1][ch]];
+        let mut lp = [st.lp[0][ch], st.lp[1][ch]];
+        let mut env = st.env[ch];
+        let (mut mod_sin, mut mod_cos) = (st.mod_sin[ch], st.mod_cos[ch]);
+        for (r, &(hum_sin, hum_cos)) in hum.iter().enumerate() {
+            let (w1, w2) = polar_pair(&mut rng);
+            let mut band = w1;
+            if let Some(f) = &self.hp {
+                band = biquad(f, &mut hp, band);
+            }
+            band = biquad(&self.lp, &mut lp, band);
+            let alpha = if target > env {
+                self.alpha_attack
+            } else {
+                self.alpha_release
+            };
+            env += alpha * (target - env);
+            if let Some((at, (s, c))) = resync {
+                if at == r {
+                    mod_sin = s;
+                    mod_cos = c;
+                }
+            }
+            let modulation = 1.0 + depth * mod_sin;
+            block[r * c + ch] = gain * band * env * modulation
+                + noise * w2
+                + hum_mv * (hum_sin * hum_cos_ch + hum_cos * hum_sin_ch);
+            // Advance the modulation phasor by one sample.
+            let (s, c) = (mod_sin, mod_cos);
+            mod_sin = s * step_cos + c * step_sin;
+            mod_cos = c * step_cos - s * step_sin;
+        }
+        for (word, value) in st.rng.iter_mut().zip(rng) {
+            word[ch] = value;
+        }
+        (st.hp[0][ch], st.hp[1][ch]) = (hp[0], hp[1]);
+        (st.lp[0][ch], st.lp[1][ch]) = (lp[0], lp[1]);
+        st.env[ch] = env;
+        (st.mod_sin[ch], st.mod_cos[ch]) = (mod_sin, mod_cos);
+    }
+
+    /// [`EmgSynth::channel_scalar`] for channels `ch` and `ch + 1` at once
+    /// (SIMD128: the same operations in the same order, two lanes), given
+    /// their white noise (`noise_rows`: per row w₁ of both, then w₂ of both).
+    #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+    fn pair_simd(
+        &mut self,
+        ch: usize,
+        block: &mut [f64],
+        hum: &[(f64, f64)],
+        resync: Option<usize>,
+        noise_rows: &[f64],
+    ) {
+        use crate::simd::v::*;
+        let c = self.config.channels;
+        let noise = f64x2_splat(self.config.noise_floor_mv);
+        let hum_mv = f64x2_splat(self.config.hum_mv);
+        let depth = f64x2_splat(self.config.modulation);
+        let gain = f64x2_splat(self.emg_gain);
+        let attack = f64x2_splat(self.alpha_attack);
+        let release = f64x2_splat(self.alpha_release);
+        let one = f64x2_splat(1.0);
+        let target = ld(&self.targets, ch);
+        let hum_cos_ch = ld(&self.consts.hum_cos, ch);
+        let hum_sin_ch = ld(&self.consts.hum_sin, ch);
+        let step_sin = ld(&self.consts.step_sin, ch);
+        let step_cos = ld(&self.consts.step_cos, ch);
+        let resync = resync.map(|r| {
+            let n = self.n + r as u64;
+            let (s0, c0) = self.modulation_at(ch, n);
+            let (s1, c1) = self.modulation_at(ch + 1, n);
+            (r, f64x2(s0, s1), f64x2(c0, c1))
+        });
+        let hp = self.hp.as_ref().map(BiquadX2::new);
+        let lp = BiquadX2::new(&self.lp);
+        let state = &mut self.state;
+        let mut hp_z = [ld(&state.hp[0], ch), ld(&state.hp[1], ch)];
+        let mut lp_z = [ld(&state.lp[0], ch), ld(&state.lp[1], ch)];
+        let mut env = ld(&state.env, ch);
+        let mut mod_sin = ld(&state.mod_sin, ch);
+        let mut mod_cos = ld(&state.mod_cos, ch);
+        for (r, (&(hum_sin, hum_cos), w)) in hum.iter().zip(noise_rows.chunks_exact(6)).enumerate()
+        {
+            let (w1, w2) = (ld(w, 0), ld(w, 2));
+            let mut band = w1;
+            if let Some(f) = &hp {
+                band = f.step(&mut hp_z, band);
+            }
+            band = lp.step(&mut lp_z, band);
+            let alpha = v128_bitselect(attack, release, f64x2_gt(target, env));
+            env = f64x2_add(env, f64x2_mul(alpha, f64x2_sub(target, env)));
+            if let Some((at, s, c)) = resync {
+                if at == r {
+                    mod_sin = s;
+                    mod_cos = c;
+                }
+            }
+            let modulation = f64x2_add(one, f64x2_mul(depth, mod_sin));
+            let emg = f64x2_mul(f64x2_mul(f64x2_mul(gain, band), env), modulation);
+            let h = f64x2_add(
+                f64x2_mul(f64x2_splat(hum_sin), hum_cos_ch),
+                f64x2_mul(f64x2_splat(hum_cos), hum_sin_ch),
+            );
+            let y = f64x2_add(f64x2_add(emg, f64x2_mul(noise, w2)), f64x2_mul(hum_mv, h));
+            st(block, r * c + ch, y);
+            let (s, c) = (mod_sin, mod_cos);
+            mod_sin = f64x2_add(f64x2_mul(s, step_cos), f64x2_mul(c, step_sin));
+            mod_cos = f64x2_sub(f64x2_mul(c, step_cos), f64x2_mul(s, step_sin));
+        }
+        st(&mut state.hp[0], ch, hp_z[0]);
+        st(&mut state.hp[1], ch, hp_z[1]);
+        st(&mut state.lp[0], ch, lp_z[0]);
+        st(&mut state.lp[1], ch, lp_z[1]);
+        st(&mut state.env, ch, env);
+        st(&mut state.mod_sin, ch, mod_sin);
+        st(&mut state.mod_cos, ch, mod_cos);
     }
 
     /// Returns to the state right after `new`: same generator states, filter
@@ -446,7 +628,7 @@ impl EmgSynth {
     /// # Ok::<(), mosaic_dsp::DspError>(())
     /// ```
     pub fn reset(&mut self) {
-        self.channels.clone_from_slice(&self.initial);
+        self.state.clone_from(&self.initial);
         self.n = 0;
     }
 }
@@ -463,6 +645,69 @@ fn biquad(s: &Biquad, z: &mut [f64; 2], x: f64) -> f64 {
     z[0] = s.b[1] * x - s.a[1] * y + z[1];
     z[1] = s.b[2] * x - s.a[2] * y;
     y
+}
+
+/// The points of the polar method of channels `ch`, `ch + 1` for
+/// `out.len() / 6` rows: per row u of both channels, v of both, s of both.
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+fn polar_points_simd(rng: &mut [Vec<u64>; 4], ch: usize, out: &mut [f64]) {
+    use crate::simd::v::*;
+    let mut state: [v128; 4] = std::array::from_fn(|i| ld_u64(&rng[i], ch));
+    for row in out.chunks_exact_mut(6) {
+        let (u, v, s) = crate::rng::polar_point_x2(&mut state);
+        st(row, 0, u);
+        st(row, 2, v);
+        st(row, 4, s);
+    }
+    for (word, x) in rng.iter_mut().zip(state) {
+        st_u64(word, ch, x);
+    }
+}
+
+/// Turns the points of [`polar_points_simd`] into the deviates in place:
+/// (u, v, s) → (w₁, w₂, s).
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+fn polar_scale_simd(rows: &mut [f64]) {
+    use crate::simd::v::*;
+    for row in rows.chunks_exact_mut(6) {
+        let (w1, w2) = crate::rng::polar_scale_x2(ld(row, 0), ld(row, 2), ld(row, 4));
+        st(row, 0, w1);
+        st(row, 2, w2);
+    }
+}
+
+/// [`biquad`] on two channels at once.
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+struct BiquadX2 {
+    b: [core::arch::wasm32::v128; 3],
+    a: [core::arch::wasm32::v128; 3],
+}
+
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+impl BiquadX2 {
+    fn new(s: &Biquad) -> Self {
+        use core::arch::wasm32::f64x2_splat;
+        BiquadX2 {
+            b: s.b.map(|x| f64x2_splat(x)),
+            a: s.a.map(|x| f64x2_splat(x)),
+        }
+    }
+
+    #[inline(always)]
+    fn step(
+        &self,
+        z: &mut [core::arch::wasm32::v128; 2],
+        x: core::arch::wasm32::v128,
+    ) -> core::arch::wasm32::v128 {
+        use core::arch::wasm32::*;
+        let y = f64x2_add(f64x2_mul(self.b[0], x), z[0]);
+        z[0] = f64x2_add(
+            f64x2_sub(f64x2_mul(self.b[1], x), f64x2_mul(self.a[1], y)),
+            z[1],
+        );
+        z[1] = f64x2_sub(f64x2_mul(self.b[2], x), f64x2_mul(self.a[2], y));
+        y
+    }
 }
 
 /// Σ h[k]² of the impulse response of the cascade (the noise power gain).
@@ -552,11 +797,11 @@ mod tests {
         for _ in 0..20 {
             s.generate(&mut out).unwrap();
             let t = s.n as f64;
-            for ch in &s.channels {
-                let exact = TAU * fract(t * ch.mod_rate) + ch.mod_phase;
+            for ch in 0..3 {
+                let exact = TAU * fract(t * s.consts.mod_rate[ch]) + s.consts.mod_phase[ch];
                 worst = worst
-                    .max((ch.mod_sin - exact.sin()).abs())
-                    .max((ch.mod_cos - exact.cos()).abs());
+                    .max((s.state.mod_sin[ch] - exact.sin()).abs())
+                    .max((s.state.mod_cos[ch] - exact.cos()).abs());
             }
         }
         assert!(worst < 1e-12, "phasor error {worst}");
