@@ -22,8 +22,8 @@ import { STATUS_ORDER, StatusHistory } from "./status-history";
 export interface StatusRecorder {
   history: StatusHistory;
   latest: BlockTelemetry | undefined;
-  /** The pipeline's batching interval as its timers report it, ms (0 without timers). */
-  batchingMs: number;
+  /** The delivery delay above which a batch reads as late, ms (NaN before any telemetry). */
+  lateMs: number;
   version: number;
 }
 
@@ -31,7 +31,7 @@ export interface StatusRecorder {
 export function useStatusRecorder(block: string): StatusRecorder {
   const client = useEngine();
   const rec = useMemo<StatusRecorder>(
-    () => ({ history: new StatusHistory(60), latest: undefined, batchingMs: 0, version: 0 }),
+    () => ({ history: new StatusHistory(60), latest: undefined, lateMs: NaN, version: 0 }),
     [block],
   );
   useEffect(
@@ -40,7 +40,7 @@ export function useStatusRecorder(block: string): StatusRecorder {
         const b = t.blocks.find((x) => x.name === block);
         if (!b) return;
         rec.latest = b;
-        rec.batchingMs = batchingOf(t);
+        rec.lateMs = lateOf(b, t);
         rec.history.push(
           t.t,
           b.status,
@@ -70,6 +70,17 @@ function batchingOf(t: Telemetry): number {
 export function lateAfterMs(desiredRate: number, batchingMs: number): number {
   return Math.max(desiredRate > 0 ? 2000 / desiredRate : 0, 20) + batchingMs;
 }
+
+/** The block's late threshold: the engine's own when its telemetry says it, else the rule's. */
+function lateOf(b: BlockTelemetry, t: Telemetry): number {
+  const said = (b.delay as { lateMs?: unknown }).lateMs;
+  return typeof said === "number" && Number.isFinite(said)
+    ? said
+    : lateAfterMs(b.desiredRate, batchingOf(t));
+}
+
+const lateMsOf = (r: StatusRecorder, desiredRate: number): number =>
+  Number.isFinite(r.lateMs) ? r.lateMs : lateAfterMs(desiredRate, 0);
 
 const STATUS_FALLBACK: Record<Status, string> = {
   ontime: "#1a9850",
@@ -106,7 +117,7 @@ export function StatusView({
         HEIGHT,
         recorder.history,
         block.desiredRate,
-        lateAfterMs(block.desiredRate, recorder.batchingMs),
+        lateMsOf(recorder, block.desiredRate),
       );
   }, [recorder, block.desiredRate]);
   const onResize = useCallback(
@@ -132,7 +143,7 @@ export function StatusView({
   const b = recorder.latest;
   const sum = recorder.history.summary();
   const status: Status = b?.status ?? "idle";
-  const late = lateAfterMs(block.desiredRate, recorder.batchingMs);
+  const late = lateMsOf(recorder, block.desiredRate);
   return (
     <div className="mp-statusview" data-view="status" data-block={block.name}>
       <div className="mp-status-now">
