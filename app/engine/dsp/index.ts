@@ -39,6 +39,7 @@ import {
   errorMessage,
   failed,
   grownCapacity,
+  HeapBlocks,
   INITIAL_CAPACITY,
   memoryReady,
   requireReady,
@@ -580,6 +581,8 @@ interface WindowingInner {
   input_ptr(): number;
   output_ptr(): number;
   ends_ptr(): number;
+  /** Byte address of each produced event (f64), when they are not all in the output buffer. */
+  starts_ptr?(): number;
   capacity(): number;
   max_windows(n: number): number;
   ensure_capacity(n: number): void;
@@ -597,6 +600,9 @@ abstract class Windowing {
   private readonly input = new Scratch();
   private readonly output = new Scratch();
   private readonly ends = new Scratch();
+  /** Where each produced event lies, when the kernel says (`starts_ptr`); else in `output`. */
+  private readonly starts: Scratch | null;
+  private readonly blocks: HeapBlocks | null;
   private produced = 0;
 
   protected constructor(
@@ -608,6 +614,9 @@ abstract class Windowing {
     this.inner = inner;
     this.channels = channels;
     this.width = width;
+    const located = inner.starts_ptr !== undefined;
+    this.starts = located ? new Scratch() : null;
+    this.blocks = located ? new HeapBlocks(width) : null;
     this.locate();
   }
 
@@ -618,6 +627,7 @@ abstract class Windowing {
     this.input.place(k.input_ptr(), this.capacity * this.channels);
     this.output.place(k.output_ptr(), most * this.width);
     this.ends.place(k.ends_ptr(), most);
+    if (k.starts_ptr !== undefined) this.starts?.place(k.starts_ptr(), most);
   }
 
   /** The most events one call of `nEvents` input events can produce. */
@@ -654,7 +664,15 @@ abstract class Windowing {
         `${this.what}.read: asked for ${k} of ${this.produced} events into ${output.length} values`,
       );
     }
-    this.output.read(output, k * this.width);
+    const blocks = this.blocks;
+    if (blocks === null) {
+      this.output.read(output, k * this.width);
+      return;
+    }
+    // Each event where the kernel says it lies (e.g. a window in its ring).
+    const starts = this.starts as Scratch;
+    const width = this.width;
+    for (let i = 0; i < k; i++) blocks.copy(starts.get(i), output, i * width);
   }
 
   /** Index (within the last `push`) of the newest input event of produced event `i`. */
@@ -683,7 +701,10 @@ const WINDOWING_CAPACITY = 8;
 /**
  * The SlidingWindow block's kernel: windows of `length` events (rows, oldest first) every `step`
  * events once `length` have arrived, multiplied by the window function. A double-written ring
- * keeps the latest `length` events contiguous: nothing moves per event.
+ * keeps the latest events contiguous: nothing moves per event. Untapered windows are copied once,
+ * from where they lie in the ring straight into the caller's array (the ring holds
+ * `length + capacity − 1` events, so every window of a call is still whole after it); tapered
+ * ones are written by the kernel, then copied.
  */
 export class SlidingWindowKernel extends Windowing {
   readonly length: number;

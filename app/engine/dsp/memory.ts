@@ -190,6 +190,39 @@ export class Scratch {
   }
 }
 
+/** Views `HeapBlocks` keeps (one per address seen; a ring of R rows has R window addresses). */
+const HEAP_BLOCKS_MAX = 4096;
+
+/**
+ * Copies blocks of `size` values that lie anywhere in the wasm memory (windows where they lie in
+ * a ring, at a different address each time) into callers' arrays with `TypedArray.set`, through
+ * views cached per address: nothing is allocated once every address has been seen. A view is
+ * only an address and a length, so it stays right whatever lies there; the cache is dropped when
+ * the memory grows (the old buffer is detached).
+ */
+export class HeapBlocks {
+  private readonly views = new Map<number, Float64Array>();
+  private buffer: ArrayBufferLike | null = null;
+
+  constructor(private readonly size: number) {}
+
+  /** Copies the `size` values at byte address `address` into `dst` from index `at`. */
+  copy(address: number, dst: Float64Array, at: number): void {
+    const h = f64();
+    if (h.buffer !== this.buffer) {
+      this.views.clear();
+      this.buffer = h.buffer;
+    }
+    let v = this.views.get(address);
+    if (v === undefined) {
+      if (this.views.size >= HEAP_BLOCKS_MAX) this.views.clear();
+      v = new Float64Array(h.buffer, address, this.size);
+      this.views.set(address, v);
+    }
+    dst.set(v, at);
+  }
+}
+
 export function disposed(what: string): Error {
   return new Error(`${what} was used after dispose()`);
 }

@@ -530,11 +530,19 @@ impl WindowScratch {
     }
 }
 
-/// [`SlidingWindow`]: events in, windows out.
+/// [`SlidingWindow`]: events in, windows out. Untapered windows are not
+/// copied: they are read where they lie in the window's ring
+/// ([`SlidingWindow::process_in_ring`], the ring holds the latest
+/// `length + capacity − 1` events); tapered windows are written into the
+/// output buffer. Either way `starts_ptr()` says where each window is.
 #[wasm_bindgen]
 pub struct WasmSlidingWindow {
     window: SlidingWindow,
+    tapered: bool,
     scratch: WindowScratch,
+    /// Byte address of each window, as f64 (read through the f64 heap view).
+    starts: Vec<f64>,
+    starts_usize: Vec<usize>,
 }
 
 #[wasm_bindgen]
@@ -554,10 +562,15 @@ impl WasmSlidingWindow {
             ))
         })?;
         let window = SlidingWindow::new(length, step, channels, f).map_err(js_err)?;
-        let width = window.window_size();
+        let tapered = f != WindowFunction::None;
+        // Only tapered windows need an output buffer.
+        let width = if tapered { window.window_size() } else { 0 };
         let mut w = WasmSlidingWindow {
             window,
+            tapered,
             scratch: WindowScratch::new(channels, width),
+            starts: Vec::new(),
+            starts_usize: Vec::new(),
         };
         w.ensure_capacity(capacity_events.max(1));
         Ok(w)
@@ -568,7 +581,8 @@ impl WasmSlidingWindow {
         self.scratch.input.as_ptr() as usize
     }
 
-    /// Byte address of the window buffer (`max_windows(capacity) × length × channels`).
+    /// Byte address of the buffer of tapered windows (`max_windows(capacity)
+    /// × length × channels`; empty without a window function).
     pub fn output_ptr(&self) -> usize {
         self.scratch.output.as_ptr() as usize
     }
@@ -576,6 +590,12 @@ impl WasmSlidingWindow {
     /// Byte address of the window ends (f64 event indices, one per window).
     pub fn ends_ptr(&self) -> usize {
         self.scratch.ends.as_ptr() as usize
+    }
+
+    /// Byte address of the window starts (f64 byte addresses of the first
+    /// value of each window, one per window; valid until the next call).
+    pub fn starts_ptr(&self) -> usize {
+        self.starts.as_ptr() as usize
     }
 
     /// Capacity of the input buffer, in events.
@@ -592,22 +612,46 @@ impl WasmSlidingWindow {
     pub fn ensure_capacity(&mut self, events: usize) {
         let most = self.window.max_windows(events);
         self.scratch.ensure(events, most);
+        if !self.tapered {
+            self.window.reserve(events);
+        }
+        if self.starts.len() < most {
+            self.starts = vec![0.0; most];
+            self.starts_usize = vec![0; most];
+        }
     }
 
-    /// Feeds `n_events` events; returns the number of windows written, or
+    /// Feeds `n_events` events; returns the number of windows produced, or
     /// −1 when `n_events > capacity()`.
     pub fn process(&mut self, n_events: usize) -> i32 {
         let s = &mut self.scratch;
         if n_events > s.capacity {
             return -1;
         }
-        match self.window.process(
-            &s.input[..n_events * s.channels],
-            &mut s.output,
-            &mut s.ends_usize,
-        ) {
-            Ok(k) => s.finish(k),
-            Err(_) => -1,
+        let input = &s.input[..n_events * s.channels];
+        let size = self.window.window_size();
+        let f64_bytes = std::mem::size_of::<f64>();
+        if self.tapered {
+            let Ok(k) = self.window.process(input, &mut s.output, &mut s.ends_usize) else {
+                return -1;
+            };
+            let base = s.output.as_ptr() as usize;
+            for (i, d) in self.starts.iter_mut().take(k).enumerate() {
+                *d = (base + i * size * f64_bytes) as f64;
+            }
+            s.finish(k)
+        } else {
+            let Ok(k) =
+                self.window
+                    .process_in_ring(input, &mut self.starts_usize, &mut s.ends_usize)
+            else {
+                return -1;
+            };
+            let base = self.window.ring().as_ptr() as usize;
+            for (d, &i) in self.starts.iter_mut().zip(&self.starts_usize[..k]) {
+                *d = (base + i * f64_bytes) as f64;
+            }
+            s.finish(k)
         }
     }
 

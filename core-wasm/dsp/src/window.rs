@@ -96,9 +96,13 @@ impl WindowFunction {
 ///
 /// A window is `length × channels` values, row-major, oldest event first,
 /// multiplied by the window function when one is set. The history is a
-/// "double-written" ring (every event is stored twice, `length` rows apart),
-/// so the latest `length` events are always one contiguous slice: nothing is
-/// allocated or rotated per event.
+/// "double-written" ring of `R ≥ length` rows (every event is stored twice,
+/// `R` rows apart), so the latest `R` events are always one contiguous slice:
+/// nothing is allocated or rotated per event. With `R = length + n − 1`
+/// ([`SlidingWindow::reserve`]`(n)`), every window that a call of up to `n`
+/// events completes is still whole in the ring when the call returns, and
+/// [`SlidingWindow::process_in_ring`] hands out where each one lies instead of
+/// copying it.
 ///
 /// ```
 /// use mosaic_dsp::{SlidingWindow, WindowFunction};
@@ -119,10 +123,12 @@ pub struct SlidingWindow {
     step: usize,
     channels: usize,
     taper: Option<Vec<f64>>,
-    /// `2·length` rows × channels.
+    /// Rows per copy of the ring, `R ≥ length`.
+    rows: usize,
+    /// `2·R` rows × channels.
     ring: Vec<f64>,
-    /// Next row to write (0..length); after a write the window is rows
-    /// `head .. head + length`.
+    /// Next row to write (0..R); after a write the latest `R` events are
+    /// rows `head .. head + R`, the window the last `length` of them.
     head: usize,
     /// Events still needed before the next window.
     until: usize,
@@ -170,6 +176,7 @@ impl SlidingWindow {
             step,
             channels,
             taper,
+            rows: length,
             ring: vec![0.0; 2 * length * channels],
             head: 0,
             until: length,
@@ -238,11 +245,11 @@ impl SlidingWindow {
     pub(crate) fn push(&mut self, event: &[f64]) -> bool {
         let c = self.channels;
         let a = self.head * c;
-        let b = (self.head + self.length) * c;
+        let b = (self.head + self.rows) * c;
         self.ring[a..a + c].copy_from_slice(event);
         self.ring[b..b + c].copy_from_slice(event);
         self.head += 1;
-        if self.head == self.length {
+        if self.head == self.rows {
             self.head = 0;
         }
         self.until -= 1;
@@ -257,8 +264,56 @@ impl SlidingWindow {
     /// The latest `length` events, oldest first, untapered.
     #[inline]
     pub(crate) fn current(&self) -> &[f64] {
+        &self.ring[self.current_start()..][..self.window_size()]
+    }
+
+    /// Index in [`SlidingWindow::ring`] of the first value of the latest
+    /// `length` events.
+    #[inline]
+    fn current_start(&self) -> usize {
+        (self.head + self.rows - self.length) * self.channels
+    }
+
+    /// The history: `2·R` rows × channels, see [`SlidingWindow::process_in_ring`].
+    pub fn ring(&self) -> &[f64] {
+        &self.ring
+    }
+
+    /// The most events one call of [`SlidingWindow::process_in_ring`] may
+    /// bring: `R − length + 1` (1 until [`SlidingWindow::reserve`]).
+    pub fn reach(&self) -> usize {
+        self.rows - self.length + 1
+    }
+
+    /// Grows the ring so that calls of up to `events` events can use
+    /// [`SlidingWindow::process_in_ring`] (`R = length + events − 1`).
+    /// Keeps the history; allocates, so call it outside the hot path (it
+    /// does nothing when the ring is large enough already).
+    ///
+    /// ```
+    /// use mosaic_dsp::{SlidingWindow, WindowFunction};
+    /// let mut sw = SlidingWindow::new(4, 2, 1, WindowFunction::None)?;
+    /// assert_eq!(sw.reach(), 1);
+    /// sw.reserve(16);
+    /// assert_eq!(sw.reach(), 16);
+    /// # Ok::<(), mosaic_dsp::DspError>(())
+    /// ```
+    pub fn reserve(&mut self, events: usize) {
+        let rows = self.length + events.max(1) - 1;
+        if rows <= self.rows {
+            return;
+        }
         let c = self.channels;
-        &self.ring[self.head * c..(self.head + self.length) * c]
+        let size = self.window_size();
+        let mut ring = vec![0.0; 2 * rows * c];
+        // The latest `length` events become rows R − length .. R (and their
+        // copies R rows later); the next event goes to row 0.
+        let latest = self.current();
+        ring[(rows - self.length) * c..][..size].copy_from_slice(latest);
+        ring[(2 * rows - self.length) * c..][..size].copy_from_slice(latest);
+        self.ring = ring;
+        self.rows = rows;
+        self.head = 0;
     }
 
     /// Feeds `input` (`n` events × `channels`) and writes every completed
@@ -286,6 +341,60 @@ impl SlidingWindow {
             if self.push(event) {
                 let out = &mut output[k * size..(k + 1) * size];
                 self.copy_current(out);
+                ends[k] = e;
+                k += 1;
+            }
+        }
+        Ok(k)
+    }
+
+    /// Feeds `input` (`n` events × `channels`, at most
+    /// [`SlidingWindow::reach`] events) like [`SlidingWindow::process`] but
+    /// copies nothing: for every completed window it writes where the window
+    /// (**untapered**) starts in [`SlidingWindow::ring`] into `starts[k]`
+    /// (`window_size()` values from there) and the index of its newest event
+    /// into `ends[k]`. The windows stay there until the next call. Returns
+    /// the number of windows.
+    ///
+    /// # Errors
+    ///
+    /// `input` is not whole events, brings more than `reach()` events, or
+    /// `starts`/`ends` cannot hold [`SlidingWindow::windows_for`]`(n)`
+    /// windows. Nothing is consumed then.
+    ///
+    /// ```
+    /// use mosaic_dsp::{SlidingWindow, WindowFunction};
+    ///
+    /// let mut sw = SlidingWindow::new(3, 2, 1, WindowFunction::None)?;
+    /// sw.reserve(5);
+    /// let (mut starts, mut ends) = ([0usize; 2], [0usize; 2]);
+    /// let k = sw.process_in_ring(&[1.0, 2.0, 3.0, 4.0, 5.0], &mut starts, &mut ends)?;
+    /// assert_eq!((k, ends), (2, [2, 4]));
+    /// assert_eq!(&sw.ring()[starts[0]..][..3], &[1.0, 2.0, 3.0]);
+    /// assert_eq!(&sw.ring()[starts[1]..][..3], &[3.0, 4.0, 5.0]);
+    /// # Ok::<(), mosaic_dsp::DspError>(())
+    /// ```
+    pub fn process_in_ring(
+        &mut self,
+        input: &[f64],
+        starts: &mut [usize],
+        ends: &mut [usize],
+    ) -> Result<usize, DspError> {
+        let n = check_multiple("input", input.len(), self.channels)?;
+        if n > self.reach() {
+            return Err(DspError::InvalidParameter {
+                name: "events per call",
+                value: n as f64,
+                expected: "at most reach() events (see SlidingWindow::reserve)",
+            });
+        }
+        let most = self.windows_for(n);
+        check_room("starts", starts.len(), most)?;
+        check_room("ends", ends.len(), most)?;
+        let mut k = 0;
+        for (e, event) in input.chunks_exact(self.channels).enumerate() {
+            if self.push(event) {
+                starts[k] = self.current_start();
                 ends[k] = e;
                 k += 1;
             }
@@ -471,6 +580,44 @@ mod tests {
         assert!(sw.process(&[1.0, 2.0, 3.0], &mut out, &mut ends).is_err());
         let k = sw.process(&[1.0, 2.0], &mut out, &mut ends).unwrap();
         assert_eq!((k, out), (1, [1.0, 2.0]));
+    }
+
+    #[test]
+    fn windows_in_the_ring_equal_copied_windows() {
+        // Batches of 1..=9 events, the ring grown twice on the way (the
+        // history must survive), against the copying path.
+        let (length, step, c) = (7, 3, 3);
+        let x: Vec<f64> = (0..200 * c).map(|i| ((i * 31) % 17) as f64 - 8.0).collect();
+        let mut copied = SlidingWindow::new(length, step, c, WindowFunction::None).unwrap();
+        let mut inring = copied.clone();
+        inring.reserve(4);
+        let (mut at, mut batch) = (0, 1);
+        while at < 200 {
+            let n = batch.min(200 - at);
+            if n > inring.reach() {
+                inring.reserve(n);
+            }
+            let input = &x[at * c..(at + n) * c];
+            let most = copied.windows_for(n);
+            let mut out = vec![0.0; most * length * c];
+            let (mut ends_a, mut ends_b, mut starts) =
+                (vec![0; most], vec![0; most], vec![0; most]);
+            let ka = copied.process(input, &mut out, &mut ends_a).unwrap();
+            let kb = inring
+                .process_in_ring(input, &mut starts, &mut ends_b)
+                .unwrap();
+            assert_eq!((ka, &ends_a), (kb, &ends_b));
+            for (k, &start) in starts.iter().enumerate().take(kb) {
+                let w = &inring.ring()[start..][..length * c];
+                assert_eq!(w, &out[k * length * c..][..length * c], "batch at {at}");
+            }
+            at += n;
+            batch = batch % 9 + 1;
+        }
+        let mut starts = [0; 4];
+        assert!(inring
+            .process_in_ring(&x[..(inring.reach() + 1) * c], &mut starts, &mut [0; 4])
+            .is_err());
     }
 
     #[test]
