@@ -335,7 +335,12 @@ interface Figures {
   blocks: string[];
   seconds: number;
   chromium: string;
-  host: { cpus: number; load1: number };
+  /**
+   * The machine during the window: `busyPercent` is all its cores' busy time (% of one core,
+   * /proc/stat), `othersPercent` the part not used by this benchmark's Chromium (other programs
+   * competing for the cores: what makes a run on a shared machine noisy).
+   */
+  host: { cpus: number; load1: number; busyPercent: number; othersPercent: number };
   sharedMemory: boolean;
   longTasks: { count: number; maxMs: number; totalMs: number; durationsMs: number[] };
   /** Long animation frames over 50 ms in the window, with the scripts they ran (diagnosis). */
@@ -419,6 +424,19 @@ interface Figures {
  * /proc; empty elsewhere), by "process type/thread name". Unlike wall-clock task durations, CPU
  * time does not grow when other programs compete for the cores.
  */
+/** Busy and total time of all cores, in USER_HZ ticks (Linux /proc/stat; zeros elsewhere). */
+function machineTimes(): { busy: number; total: number } {
+  try {
+    const line = readFileSync("/proc/stat", "utf8").split("\n")[0]!;
+    const f = line.trim().split(/\s+/).slice(1).map(Number);
+    const total = f.reduce((a, b) => a + b, 0);
+    const idle = (f[3] ?? 0) + (f[4] ?? 0);
+    return { busy: total - idle, total };
+  } catch {
+    return { busy: 0, total: 0 };
+  }
+}
+
 function cpuTimes(): Map<string, number> {
   const out = new Map<string, number>();
   let pids: string[];
@@ -493,6 +511,7 @@ async function measure(page: Page, o: Options): Promise<Figures> {
   const e0 = await engineSnapshot(page);
   const m0 = await metrics(cdp);
   const c0 = cpuTimes();
+  const h0 = machineTimes();
   const start = await snapshot(page);
   const perSecond: Record<string, number[]> = {};
   let prev = start;
@@ -509,6 +528,7 @@ async function measure(page: Page, o: Options): Promise<Figures> {
   const end = prev;
   const m1 = await metrics(cdp);
   const c1 = cpuTimes();
+  const h1 = machineTimes();
   const e1 = await engineSnapshot(page);
   const rec = (await page.evaluate("window.__benchEngine")) as EngineRecord;
   const elapsed = (end.now - start.now) / 1000;
@@ -520,6 +540,8 @@ async function measure(page: Page, o: Options): Promise<Figures> {
     const used = round((100 * (v - (c0.get(k) ?? 0))) / wall, 1);
     if (used >= 0.5) cpu[k] = used;
   }
+  // Busy ticks of all cores over the window, as % of one core (USER_HZ 100).
+  const machineBusy = round((h1.busy - h0.busy) / wall, 1);
   const script = share("ScriptDuration");
   const style = share("RecalcStyleDuration");
   const layout = share("LayoutDuration");
@@ -556,7 +578,15 @@ async function measure(page: Page, o: Options): Promise<Figures> {
     blocks: o.blocks,
     seconds: round(elapsed, 1),
     chromium: o.chromium,
-    host: { cpus: cpus().length, load1: round(loadavg()[0] ?? 0, 2) },
+    host: {
+      cpus: cpus().length,
+      load1: round(loadavg()[0] ?? 0, 2),
+      busyPercent: machineBusy,
+      othersPercent: round(
+        Math.max(0, machineBusy - Object.values(cpu).reduce((a, b) => a + b, 0)),
+        1,
+      ),
+    },
     sharedMemory,
     longTasks: {
       count: tasks.length,
@@ -765,7 +795,7 @@ function markdown(f: Figures): string {
   const lines = [
     "# UI benchmark",
     "",
-    `${f.date} · ${f.mode === "app" ? "the app shell" : "panels alone (harness)"} · \`${f.pipeline}\` · scopes of ${f.blocks.join(", ")} · ${f.seconds} s measured · Chromium headless (${f.chromium}) · ${f.host.cpus} CPUs, load ${f.host.load1} · shared memory: ${f.sharedMemory ? "yes" : "no"}`,
+    `${f.date} · ${f.mode === "app" ? "the app shell" : "panels alone (harness)"} · \`${f.pipeline}\` · scopes of ${f.blocks.join(", ")} · ${f.seconds} s measured · Chromium headless (${f.chromium}) · ${f.host.cpus} CPUs, load ${f.host.load1}, ${f.host.busyPercent} % of a core busy of which ${f.host.othersPercent} % by other programs · shared memory: ${f.sharedMemory ? "yes" : "no"}`,
     "",
     "| figure | target | measured | result |",
     "| --- | --- | --- | --- |",
