@@ -82,7 +82,19 @@ export class RealtimeLoop {
   wake(): void {
     Atomics.add(this.o.doorbell, BELL_WAKE, 1);
     Atomics.notify(this.o.doorbell, BELL_WAKE);
+    // On a worker with I/O, a wake-up comes from an I/O callback (a datagram became a frame):
+    // deliver right after the callback returns, not a turn of the event loop later.
+    if (this.eventLoop && !this.stepSoon && !this.stopped) {
+      this.stepSoon = true;
+      queueMicrotask(this.stepNow);
+    }
   }
+
+  private stepSoon = false;
+  private readonly stepNow = (): void => {
+    this.stepSoon = false;
+    if (!this.stopped) this.step();
+  };
 
   /**
    * The next wake-up: the scheduler's, or the telemetry's when no tick comes soon enough. Telemetry
