@@ -123,6 +123,51 @@ describe("SIMD128 paths", () => {
     }
   });
 
+  it("FeatureKernel: Hudgins' set (MAV, WL, ZC, SSC in one pass), the same bits as the scalar code", () => {
+    const special = [NaN, Infinity, -Infinity, 0, -0, 1e300, -1e-300];
+    // Any order of the four features; thresholds 0 and not (SSC's test is rewritten in that pass).
+    const sets: FeatureRequest[][] = [
+      [
+        { feature: "MAV" },
+        { feature: "WL" },
+        { feature: "ZC", threshold: 0 },
+        { feature: "SSC", threshold: 0 },
+      ],
+      [
+        { feature: "SSC", threshold: 0.05 },
+        { feature: "ZC", threshold: 0.1 },
+        { feature: "MAV" },
+        { feature: "WL" },
+      ],
+      [
+        { feature: "ZC", threshold: -0.1 },
+        { feature: "MAV" },
+        { feature: "SSC", threshold: -0.02 },
+        { feature: "WL" },
+      ],
+    ];
+    for (const requests of sets) {
+      for (const rows of [2, 3, 4, 50, 410]) {
+        for (const channels of [1, 2, 3, 5, 8, 9, 256]) {
+          const windows = 2;
+          const next = noise(rows * 7 + channels);
+          const x = Float64Array.from({ length: windows * rows * channels }, (_, i) =>
+            i % 89 === 3 ? special[i % special.length]! : i % 13 === 0 ? 0 : next(),
+          );
+          const [simd, scalar] = bothPaths(() => {
+            const k = new FeatureKernel(requests, rows, channels);
+            const out = new Float64Array(windows * k.width);
+            k.process(x, out, windows);
+            k.dispose();
+            return out;
+          });
+          const what = `${requests.map((r) => r.feature).join(",")}: ${rows} × ${channels}`;
+          expect(firstDifference(simd, scalar), what).toBe(-1);
+        }
+      }
+    }
+  });
+
   it("WindowedFeatureKernel and SlidingWindowKernel + FeatureKernel: the same bits either way", () => {
     const requests: FeatureRequest[] = [
       { feature: "MAV" },

@@ -136,7 +136,11 @@ impl FeatureSpec {
 /// the second, … (LibEMG's concatenation order). The window is read in
 /// strips of 8 adjacent channels (a cache line per row) whose accumulators
 /// stay in registers; every channel sums its samples in order. Nothing is
-/// allocated in `process`.
+/// allocated in `process`. With SIMD128 (the wasm build) a strip is four
+/// vectors of two channels, and Hudgins' set (exactly MAV, WL, ZC and SSC
+/// with the product rule, in any order: FeatureSet's default) is computed in
+/// one pass over pairs of channels; both give the same bits as the scalar
+/// code ([`crate::set_simd_enabled`]).
 ///
 /// ```
 /// use mosaic_dsp::{Feature, FeatureKernel, FeatureSpec};
@@ -308,6 +312,19 @@ impl FeatureKernel {
         let acc = &mut self.acc;
         let simd = crate::simd::simd_enabled();
         let mut c0 = 0;
+        #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+        if let (true, Some(at)) = (simd, hudgins(&self.specs)) {
+            // Hudgins' set in one pass per strip (the usual request).
+            let (tz, ts) = (self.specs[at[2]].threshold, self.specs[at[3]].threshold);
+            while c0 + FUSED <= c {
+                let mut out = [[0.0; FUSED]; 4];
+                strip_hudgins::<{ FUSED / 2 }>(w, c, c0, rows, tz, ts, &mut out);
+                for (&i, o) in at.iter().zip(&out) {
+                    acc[i * c + c0..][..FUSED].copy_from_slice(o);
+                }
+                c0 += FUSED;
+            }
+        }
         while c0 < c {
             let left = c - c0;
             let width = if left >= BLOCK {
@@ -469,6 +486,88 @@ fn strip<const B: usize>(
         }
     }
     acc
+}
+
+/// Channels per strip of [`strip_hudgins`].
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+const FUSED: usize = 2;
+
+/// Where MAV, WL, ZC and SSC (product rule) are in `specs` when `specs` is
+/// exactly those four, in any order.
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+fn hudgins(specs: &[FeatureSpec]) -> Option<[usize; 4]> {
+    if specs.len() != 4 {
+        return None;
+    }
+    let find = |f: Feature| specs.iter().position(|s| s.feature == f);
+    let at = [
+        find(Feature::Mav)?,
+        find(Feature::Wl)?,
+        find(Feature::Zc)?,
+        find(Feature::Ssc)?,
+    ];
+    Some(at)
+}
+
+/// MAV (raw sum), WL, ZC and SSC of channels `c0 .. c0 + 2·V` in one pass
+/// over the rows (SIMD128), into `out` in that order. Each feature sums or
+/// counts in sample order with the same values as [`strip`]: with
+/// `d_r = x_r − x_{r−1}`, `|x_{r−1} − x_r| = |d_r|` and SSC's
+/// `(x_{r−1} − x_{r−2})·(x_{r−1} − x_r) = −(d_{r−1}·d_r)` exactly (IEEE
+/// subtraction and multiplication are symmetric in sign), so
+/// `≥ T` ⇔ `d_{r−1}·d_r ≤ −T`: bit-identical results.
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+#[inline(always)]
+fn strip_hudgins<const V: usize>(
+    w: &[f64],
+    c: usize,
+    c0: usize,
+    rows: usize,
+    tz: f64,
+    ts: f64,
+    out: &mut [[f64; FUSED]; 4],
+) {
+    use crate::simd::v::*;
+    let at = |r: usize| -> [v128; V] {
+        let i = r * c + c0;
+        let x = &w[i..i + 2 * V];
+        core::array::from_fn(|k| ld(x, 2 * k))
+    };
+    let zero = f64x2_splat(0.0);
+    let (tz, nts) = (f64x2_splat(tz), f64x2_splat(-ts));
+    let mut mav = [zero; V];
+    let mut wl = [zero; V];
+    let mut zc = [i64x2_splat(0); V];
+    let mut ssc = [i64x2_splat(0); V];
+    let mut p = at(0);
+    let mut dp = [zero; V];
+    for k in 0..V {
+        mav[k] = f64x2_add(mav[k], f64x2_abs(p[k]));
+    }
+    for r in 1..rows {
+        let x = at(r);
+        for k in 0..V {
+            let d = f64x2_sub(x[k], p[k]);
+            let ad = f64x2_abs(d);
+            mav[k] = f64x2_add(mav[k], f64x2_abs(x[k]));
+            wl[k] = f64x2_add(wl[k], ad);
+            let sign = f64x2_lt(f64x2_mul(p[k], x[k]), zero);
+            zc[k] = i64x2_add(zc[k], v128_and(sign, f64x2_ge(ad, tz)));
+            if r >= 2 {
+                ssc[k] = i64x2_add(ssc[k], f64x2_le(f64x2_mul(dp[k], d), nts));
+            }
+            dp[k] = d;
+        }
+        p = x;
+    }
+    for k in 0..V {
+        st(&mut out[0], 2 * k, mav[k]);
+        st(&mut out[1], 2 * k, wl[k]);
+        for (o, hits) in [(2, zc[k]), (3, ssc[k])] {
+            out[o][2 * k] = -i64x2_extract_lane::<0>(hits) as f64;
+            out[o][2 * k + 1] = -i64x2_extract_lane::<1>(hits) as f64;
+        }
+    }
 }
 
 /// [`strip`] for channels `c0 .. c0 + 2·V` with SIMD128 (`V` vectors of two

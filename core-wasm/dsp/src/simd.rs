@@ -1,10 +1,11 @@
 //! WebAssembly SIMD128 paths of the hot kernels.
 //!
 //! The wasm build (`scripts/build-wasm.sh`) compiles with
-//! `-C target-feature=+simd128`; there the feature kernel ([`crate::FeatureKernel`])
-//! and the EMG synthesiser ([`crate::EmgSynth`], with a two-lane logarithm)
-//! process two channels per instruction (`f64x2`, `i64x2`). Every other build
-//! (the native `cargo test`) has only the scalar code.
+//! `-C target-feature=+simd128`; there the feature kernel ([`crate::FeatureKernel`],
+//! with a one-pass path for MAV, WL, ZC and SSC) and the EMG synthesiser
+//! ([`crate::EmgSynth`], with a two-lane logarithm) process two channels per
+//! instruction (`f64x2`, `i64x2`). Every other build (the native
+//! `cargo test`) has only the scalar code.
 //!
 //! The biquad of [`crate::FilterBank`] stays scalar: SIMD128 versions (row by
 //! row over the channels, or strips of 2–8 channels running through a block
