@@ -34,7 +34,8 @@ export interface LoopHandle {
 
 export interface LoopHooks {
   telemetryIntervalS: number;
-  onTelemetry(): void;
+  /** `at`: when the step that reports began (status is judged then; see Runtime.telemetry). */
+  onTelemetry(at?: number): void;
   onFinished(): void;
 }
 
@@ -465,7 +466,7 @@ export class EngineSession {
     rt.start();
     this.loop = this.platform.startLoop(rt, {
       telemetryIntervalS: 0.05,
-      onTelemetry: () => this.flush(),
+      onTelemetry: (at) => this.flush(at),
       onFinished: () => {
         this.flush();
         this.setState("finished");
@@ -476,10 +477,10 @@ export class EngineSession {
   }
 
   /** Sends telemetry, events and the panel data gathered since the previous flush. */
-  private flush(): void {
+  private flush(at?: number): void {
     const rt = this.rt;
     if (!rt) return;
-    const telemetry = rt.telemetry();
+    const telemetry = rt.telemetry(at);
     const events = telemetry.events;
     telemetry.events = [];
     this.platform.post({ type: "telemetry", telemetry });

@@ -183,7 +183,7 @@ function start(): void {
     doorbell,
     precision: init.precision,
     telemetryIntervalS,
-    onTelemetry: () => post({ type: "telemetry", report: report(runtime.telemetry()) }),
+    onTelemetry: (at) => post({ type: "telemetry", report: report(runtime.telemetry(at)) }),
     onFinished: () => post({ type: "finished", telemetry: runtime.telemetry() }),
   });
   rt.onWake = () => loop?.wake();

@@ -1,15 +1,12 @@
 /**
  * The fallback real-time loop for places without shared memory (a browser page that is not
  * cross-origin isolated cannot use Atomics.wait): it sleeps with the platform's timer until the
- * next deadline, and polls through the event loop for waits shorter than the timer's clamping
- * (browsers round nested timeouts up to ~4 ms). Ticks are less precise than with RealtimeLoop;
- * late ones are skipped and counted by the scheduler, and the status shows it.
+ * next wake-up and never polls. Browsers round nested timeouts up to ~4 ms, so it wakes later
+ * than RealtimeLoop would; lossless timers then deliver the ticks that became due in one batch
+ * (nothing is lost, the delivery delay shows the difference).
  */
 import type { Clock } from "../clock";
 import type { Runtime } from "./runtime";
-
-/** Below this, `setTimeout` is too coarse: poll through the event loop instead. */
-const TIMER_GRAIN_S = 0.004;
 
 export interface CoarseLoopOptions {
   runtime: Runtime;
@@ -19,7 +16,8 @@ export interface CoarseLoopOptions {
   /** Runs `fn` on the next turn of the event loop (e.g. through a MessageChannel). */
   yieldNow: (fn: () => void) => void;
   telemetryIntervalS: number;
-  onTelemetry: () => void;
+  /** `at`: when the step that reports began. */
+  onTelemetry: (at: number) => void;
   onFinished: () => void;
 }
 
@@ -54,18 +52,19 @@ export class CoarseLoop {
     const run = (): void => {
       if (gen === this.generation) this.turn();
     };
-    if (delayS >= TIMER_GRAIN_S) this.o.sleep(run, (delayS - TIMER_GRAIN_S / 2) * 1000);
+    if (delayS > 0) this.o.sleep(run, delayS * 1000);
     else this.o.yieldNow(run);
   }
 
   private turn(): void {
     if (this.stopped) return;
     const { runtime: rt, clock } = this.o;
-    rt.step(clock.now());
+    const at = clock.now();
+    rt.step(at);
     const now = clock.now();
     if (now - this.lastTelemetry >= this.o.telemetryIntervalS) {
       this.lastTelemetry = now;
-      this.o.onTelemetry();
+      this.o.onTelemetry(at);
     }
     if (rt.finished && !this.finishedReported) {
       this.finishedReported = true;

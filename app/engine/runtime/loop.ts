@@ -42,7 +42,8 @@ export interface LoopOptions {
   doorbell: Int32Array;
   precision: boolean;
   telemetryIntervalS: number;
-  onTelemetry: () => void;
+  /** `at`: when the step that reports began. */
+  onTelemetry: (at: number) => void;
   onFinished: () => void;
 }
 
@@ -110,14 +111,15 @@ export class RealtimeLoop {
   private step(): void {
     const { runtime: rt, clock } = this.o;
     rt.scheduler.earlyTolerance = this.o.precision ? 0.000002 : this.margin + 0.000002;
-    rt.step(clock.now());
+    const at = clock.now();
+    rt.step(at);
     const now = clock.now();
     const interval = this.o.telemetryIntervalS;
     if (now - this.lastTelemetry >= interval) {
       // Keep the average cadence (a report rides on the first wake-up after it is due).
       this.lastTelemetry =
         now - this.lastTelemetry < 2 * interval ? this.lastTelemetry + interval : now;
-      this.o.onTelemetry();
+      this.o.onTelemetry(at);
     }
     if (rt.finished && !this.finishedReported) {
       this.finishedReported = true;

@@ -403,6 +403,32 @@ describe("status", () => {
     expect(s.evaluate(1.49 + 0.101).status).toBe("idle");
   });
 
+  test("a late batch is lagging for as long as it was delayed, at least 100 ms, at any rate", () => {
+    for (const hz of [25, 1926]) {
+      const s = new StatusTracker(hz);
+      s.batchS = 0.005;
+      let k = 0;
+      /** Outputs on time up to `t` (so the block is not idle), then the status at `t`. */
+      const at = (t: number) => {
+        for (; k / hz <= t; k++) s.record(frameAt(k / hz), k / hz);
+        return s.evaluate(t);
+      };
+      const now = 10;
+      at(now);
+      // The late threshold: max(2 periods, 50 ms) + the batching interval.
+      expect(s.lateAfter()).toBeCloseTo(Math.max(2 / hz, 0.05) + 0.005, 12);
+      s.delivered(now - s.lateAfter() + 0.001, now);
+      expect(at(now).status).toBe("ontime");
+      s.delivered(now - 0.3, now); // 300 ms late
+      expect(at(now).status).toBe("lagging");
+      expect(at(now + 0.29).lagging).toBe(true);
+      expect(at(now + 0.31).lagging).toBe(false);
+      s.delivered(now + 0.4 - s.lateAfter() - 0.001, now + 0.4); // just late: held 100 ms
+      expect(at(now + 0.49).lagging).toBe(true);
+      expect(at(now + 0.51).lagging).toBe(false);
+    }
+  });
+
   test("lagging below 95 % of the desired rate", () => {
     const s = new StatusTracker(100);
     for (let i = 0; i < 100; i++) s.record(frameAt(i / 94), i / 94);

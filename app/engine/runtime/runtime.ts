@@ -1056,8 +1056,13 @@ export class Runtime {
   // -------------------------------------------------------------------------------------------
   // Telemetry
 
-  telemetry(): Telemetry {
-    const now = this.clock.now();
+  /**
+   * Per-block status, rates and counters. `at` is when status is judged (default now): the loops
+   * pass the start of the step that reports, so that a worker stalled inside that step does not
+   * see its own blocks as idle for want of outputs it had not yet had the chance to make.
+   */
+  telemetry(at?: number): Telemetry {
+    const now = at ?? this.clock.now();
     const blocks: BlockTelemetry[] = this.nodes.map((n) => {
       const s = n.status;
       const ev = s.evaluate(now);

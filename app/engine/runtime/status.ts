@@ -3,10 +3,11 @@
  * - rate = (n − 1) / (t_last − t_first) over the last 100 outputs (event timestamps);
  * - idle (grey) when there was no output for 10 periods (plus the batching interval, during
  *   which a batch is allowed to wait), or none at all;
- * - lagging (red) when rate < 95 % of DesiredRate, or when, within the current 100-output
- *   window, an input batch reached the block late: its oldest event waited longer than
- *   max(2 periods, 50 ms) plus the batching interval (the engine is behind real time; lossless
- *   timers keep rates exact, so a rate alone would not show it);
+ * - lagging (red) when rate < 95 % of DesiredRate, or when an input batch reached the block
+ *   late: its oldest event waited longer than max(2 periods, 50 ms) plus the batching interval
+ *   (the engine is behind real time; lossless timers keep rates exact, so a rate alone would not
+ *   show it). A late batch keeps the block red for as long as it was delayed, at least LATE_HOLD_S,
+ *   whatever the block's rate;
  * - stumbling (magenta) when one `process` call (measured) took longer than the time its events
  *   span, max(1, n) / DesiredRate, within the current window;
  * - on time (green) otherwise. Precedence idle > lagging > stumbling > on time.
@@ -34,6 +35,8 @@ export const LATE_PERIODS = 2;
  * descheduled VM) that a busy machine has without the engine being behind.
  */
 export const LATE_MIN_S = 0.05;
+/** The shortest time a late batch shows (two telemetry reports at 20 Hz: visible in the UI). */
+export const LATE_HOLD_S = 0.1;
 
 export interface StatusEval {
   status: Status;
@@ -53,7 +56,8 @@ export class StatusTracker {
   events = 0;
   lastWall = -Infinity;
   lastOverrunWall = -Infinity;
-  lastLateWall = -Infinity;
+  /** Until when a late batch keeps the block lagging (clock time). */
+  lateUntil = -Infinity;
   /** The batching interval that applies to this block's inputs, s (set by the runtime). */
   batchS = 0;
 
@@ -128,7 +132,8 @@ export class StatusTracker {
     const d = now - oldest;
     this.delay.add(d);
     if (d > this.delayMaxWindow) this.delayMaxWindow = d;
-    if (d > this.lateAfter()) this.lastLateWall = now;
+    if (d > this.lateAfter())
+      this.lateUntil = Math.max(this.lateUntil, now + Math.max(d, LATE_HOLD_S));
   }
 
   /** The delivery delay above which a batch is late (the block reads as lagging), s. */
@@ -191,7 +196,7 @@ export class StatusTracker {
     const n = this.inWindow;
     const windowStart = n > 0 ? this.wall[(this.idx - n + RATE_WINDOW) % RATE_WINDOW]! : now;
     const slow = d > 0 && rate === rate && rate < LAG_FRACTION * d;
-    const lagging = slow || this.lastLateWall >= windowStart;
+    const lagging = slow || now < this.lateUntil;
     const stumbling = d > 0 && this.lastOverrunWall >= windowStart;
     const status: Status = lagging ? "lagging" : stumbling ? "stumbling" : "ontime";
     return { status, rate, lagging, stumbling };

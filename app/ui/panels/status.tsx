@@ -10,7 +10,7 @@
  */
 import { useCallback, useEffect, useMemo, useRef, useState, type ReactNode } from "react";
 import type { BlockInfo } from "../../engine/protocol";
-import type { BlockTelemetry, Telemetry } from "../../engine/runtime/runtime";
+import type { BlockTelemetry } from "../../engine/runtime/runtime";
 import type { Status } from "../../engine/runtime/status";
 import { useEngine } from "../client/hooks";
 import { StatusIcon, STATUS_HELP, statusText } from "../graph/status";
@@ -40,7 +40,7 @@ export function useStatusRecorder(block: string): StatusRecorder {
         const b = t.blocks.find((x) => x.name === block);
         if (!b) return;
         rec.latest = b;
-        rec.lateMs = lateOf(b, t);
+        rec.lateMs = b.delay.lateMs;
         rec.history.push(
           t.t,
           b.status,
@@ -56,31 +56,8 @@ export function useStatusRecorder(block: string): StatusRecorder {
   return rec;
 }
 
-/** The largest batching interval the pipeline's timers report, ms. */
-function batchingOf(t: Telemetry): number {
-  let most = 0;
-  for (const b of t.blocks) if (b.timer && b.timer.batchingMs > most) most = b.timer.batchingMs;
-  return most;
-}
-
-/**
- * The delivery delay above which a batch reads as late (the block turns lagging), ms: as the
- * engine's status rule, max(2 periods, 20 ms) plus the batching interval.
- */
-export function lateAfterMs(desiredRate: number, batchingMs: number): number {
-  return Math.max(desiredRate > 0 ? 2000 / desiredRate : 0, 20) + batchingMs;
-}
-
-/** The block's late threshold: the engine's own when its telemetry says it, else the rule's. */
-function lateOf(b: BlockTelemetry, t: Telemetry): number {
-  const said = (b.delay as { lateMs?: unknown }).lateMs;
-  return typeof said === "number" && Number.isFinite(said)
-    ? said
-    : lateAfterMs(b.desiredRate, batchingOf(t));
-}
-
-const lateMsOf = (r: StatusRecorder, desiredRate: number): number =>
-  Number.isFinite(r.lateMs) ? r.lateMs : lateAfterMs(desiredRate, 0);
+/** The block's late threshold as the engine says it (NaN before any telemetry). */
+const lateMsOf = (r: StatusRecorder): number => r.lateMs;
 
 const STATUS_FALLBACK: Record<Status, string> = {
   ontime: "#1a9850",
@@ -117,7 +94,7 @@ export function StatusView({
         HEIGHT,
         recorder.history,
         block.desiredRate,
-        lateMsOf(recorder, block.desiredRate),
+        lateMsOf(recorder),
       );
   }, [recorder, block.desiredRate]);
   const onResize = useCallback(
@@ -143,7 +120,7 @@ export function StatusView({
   const b = recorder.latest;
   const sum = recorder.history.summary();
   const status: Status = b?.status ?? "idle";
-  const late = lateMsOf(recorder, block.desiredRate);
+  const late = lateMsOf(recorder);
   return (
     <div className="mp-statusview" data-view="status" data-block={block.name}>
       <div className="mp-status-now">
