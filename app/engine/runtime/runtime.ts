@@ -1076,13 +1076,13 @@ export class Runtime {
         status: ev.status,
         lagging: ev.lagging,
         stumbling: ev.stumbling,
-        rate: Number.isFinite(ev.rate) ? ev.rate : 0,
+        rate: Number.isFinite(ev.rate) ? hz(ev.rate) : 0,
         desiredRate: n.desiredRate,
         events: s.events,
-        computeLastMs: s.computeLast,
-        computeMeanMs: s.callsWindow ? s.computeSumWindow / s.callsWindow : 0,
-        computeMaxMs: s.computeMaxWindow,
-        latencyMs: s.latencyN ? (s.latencySum / s.latencyN) * 1000 : 0,
+        computeLastMs: ms(s.computeLast),
+        computeMeanMs: s.callsWindow ? ms(s.computeSumWindow / s.callsWindow) : 0,
+        computeMaxMs: ms(s.computeMaxWindow),
+        latencyMs: s.latencyN ? ms((s.latencySum / s.latencyN) * 1000) : 0,
         delay: delayFigures(s),
         dropsIn,
         text: n.text,
@@ -1091,9 +1091,9 @@ export class Runtime {
         finished: n.finished,
         timing: {
           n: s.dtN,
-          meanDt: s.dtMean,
-          stdDt: s.dtStd(),
-          computeTotalMs: s.computeTotal,
+          meanDt: seconds(s.dtMean),
+          stdDt: seconds(s.dtStd()),
+          computeTotalMs: ms(s.computeTotal),
           calls: s.calls,
         },
       };
@@ -1106,7 +1106,7 @@ export class Runtime {
           batchingMs: timer.batchS * 1000,
           latenessP50Us: h ? h.quantile(0.5) : 0,
           latenessP99Us: h ? h.quantile(0.99) : 0,
-          latenessMaxUs: h && h.count ? h.maxUs : 0,
+          latenessMaxUs: h && h.count ? Math.round(h.maxUs * 10) / 10 : 0,
           running: timer.running,
         };
       }
@@ -1120,7 +1120,7 @@ export class Runtime {
       to: e.to.name,
       toIndex: e.toIndex,
       subscribed: e.subscribed,
-      rate: e.rate(),
+      rate: hz(e.rate()),
       delivered: e.delivered,
       dropped: e.dropped,
       pending: e.pendingEvents,
@@ -1139,13 +1139,31 @@ export function batchingOf(spec: PipelineSpec): number {
 
 function delayFigures(s: StatusTracker): BlockTelemetry["delay"] {
   const h = s.delay;
-  const ms = (x: number): number => (Number.isFinite(x) ? x * 1000 : 0);
+  const toMs = (x: number): number => (Number.isFinite(x) ? ms(x * 1000) : 0);
   return {
-    p50Ms: ms(h.p50),
-    p99Ms: ms(h.p99),
-    maxMs: ms(h.max),
-    windowMaxMs: ms(s.delayMaxWindow),
+    p50Ms: toMs(h.p50),
+    p99Ms: toMs(h.p99),
+    maxMs: toMs(h.max),
+    windowMaxMs: toMs(s.delayMaxWindow),
     n: h.count,
-    lateMs: s.lateAfter() * 1000,
+    lateMs: toMs(s.lateAfter()),
   };
+}
+
+// Telemetry figures are rounded to what they can mean (a clock read takes ~50 ns; rates are
+// judged at 95 %): shorter JSON, encoded, posted and printed 20 times a second by every worker.
+
+/** Milliseconds to 0.1 µs. */
+function ms(x: number): number {
+  return Math.round(x * 1e4) / 1e4;
+}
+
+/** Hz to 0.1 mHz. */
+function hz(x: number): number {
+  return Math.round(x * 1e4) / 1e4;
+}
+
+/** Seconds to 1 ns (NaN stays NaN). */
+function seconds(x: number): number {
+  return Math.round(x * 1e9) / 1e9;
 }
