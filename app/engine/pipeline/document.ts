@@ -27,21 +27,14 @@
  * - `normalize()` (what `mosaic format` adds to a plain round trip): the file ends with a line
  *   break. Nothing else is normalised; CRLF files stay CRLF (new lines use the file's ending).
  */
-import {
-  isMap,
-  isPair,
-  isScalar,
-  isSeq,
-  parseDocument,
-  stringify,
-  visit,
-  YAMLParseError,
-} from "yaml";
+import { isMap, isPair, isScalar, isSeq, stringify, visit, YAMLParseError } from "yaml";
 import type { Document, Node as YamlNode, Pair, Scalar, YAMLMap, YAMLSeq } from "yaml";
 import type { Catalog } from "../catalog";
 import { errorMessage, type Diagnostic } from "../diagnostics";
 import { closest } from "../suggest";
 import { BLOCK_NAME_RE, loadPipeline, type LoadResult } from "./loader";
+import { parsePipelineYaml } from "./parse";
+import { positionalArgs } from "./positional";
 
 export interface AddBlockOptions {
   inputs?: string[];
@@ -187,8 +180,9 @@ function checkFinite(v: number, what: string): void {
   }
 }
 
+/** Parses the text as the loader does (parse.ts). */
 function parseText(text: string): Document {
-  const doc = parseDocument(text, { uniqueKeys: true, prettyErrors: false });
+  const { doc } = parsePipelineYaml(text);
   if (doc.errors.length === 0) {
     // The parser accepts an alias whose anchor is gone (it fails later, when read).
     visit(doc, {
@@ -468,7 +462,7 @@ export class PipelineDocument {
     const def = catalog.get(type);
     if (!def) throw new Error(`block '${block}': unknown block type '${type}'`);
     if (!def.legacyParams) throw new Error(`block '${block}': ${def.type} has no positional form`);
-    const args = legacyArgs(params);
+    const args = positionalArgs(params);
     let raw: unknown;
     try {
       raw = def.legacyParams(args.length === 1 && args[0] === "" ? [] : args);
@@ -919,21 +913,6 @@ function lineStart(src: string, offset: number): number {
 function lineEndAfter(src: string, offset: number): number {
   const nl = src.indexOf("\n", offset);
   return nl < 0 ? src.length : nl + 1;
-}
-
-/** MOSAIC's positional Params as the strings the loader hands to `legacyParams`. */
-function legacyArgs(seq: YAMLSeq): string[] {
-  return seq.items.map((item) => {
-    const s = str(item);
-    if (s !== undefined) return s;
-    if (isScalar(item) && item.value === null) return "";
-    if (isMap(item) && item.items.length === 1) {
-      const p = item.items[0]!;
-      return `${str(p.key) ?? ""}:${str(p.value) ?? ""}`;
-    }
-    if (isSeq(item)) return item.items.map((x) => str(x) ?? "").join(";");
-    return "";
-  });
 }
 
 /** Undo/redo over text snapshots (the UI keeps one per open file). */

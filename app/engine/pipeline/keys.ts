@@ -1,0 +1,367 @@
+/**
+ * Loader stage 3, block keys: everything a block says besides its Params — Type (looked up in the
+ * catalog), DesiredRate, Inputs, Path, Worker, BatchingMs, Queue and
+ * Layout — and the pipeline's settings (`Pipeline: { BatchingMs }`). Each bad key is one
+ * positioned error; the stage never throws.
+ */
+import { isMap, isScalar, isSeq, type Node as YamlNode, type YAMLMap } from "yaml";
+import type { AnyBlockDefinition } from "../block";
+import type { Catalog } from "../catalog";
+import { closest } from "../suggest";
+import { Collector, describeNode, isNullish, scalarString } from "./collector";
+import {
+  BLOCK_KEYS,
+  QUEUE_POLICIES,
+  SETTINGS_KEY,
+  SETTINGS_KEYS,
+  WORKER_RE,
+  type InputRef,
+  type PipelineSettings,
+  type QueuePolicy,
+  type QueueSpec,
+  type SourcePos,
+} from "./spec";
+
+/** What stage 3 read from one block. */
+export interface BlockKeys {
+  /** Undefined when Type is missing, bad or unknown (reported). */
+  def: AnyBlockDefinition | undefined;
+  /** The canonical type name ("" when unknown). */
+  type: string;
+  /** The type name as written (undefined when missing or not a string). */
+  written: string | undefined;
+  /** Where the Type value is. */
+  typePos: SourcePos;
+  /** True when the block loads under another name (a block alias). */
+  renamed: boolean;
+  desiredRate: number | undefined;
+  inputs: InputRef[];
+  inputsPos: SourcePos;
+  path: string | undefined;
+  worker: string;
+  batchingMs: number | undefined;
+  queue: QueueSpec;
+  layout: { x: number; y: number } | undefined;
+  /** The Params node (undefined: no Params key). */
+  paramsNode: unknown;
+  paramsPos: SourcePos;
+}
+
+/** Stage 3 for one block (`at`: where its name is). */
+export function readBlockKeys(
+  c: Collector,
+  name: string,
+  at: SourcePos,
+  map: YAMLMap,
+  catalog: Catalog,
+): BlockKeys {
+  const get = (k: string): { node: unknown; keyPos: SourcePos } | undefined => {
+    const p = map.items.find((it) => scalarString(it.key) === k);
+    return p ? { node: p.value, keyPos: c.pos(p.key as YamlNode) } : undefined;
+  };
+  for (const it of map.items) {
+    const k = scalarString(it.key) ?? "";
+    if (!(BLOCK_KEYS as readonly string[]).includes(k)) {
+      const suggestion = closest(k, BLOCK_KEYS);
+      c.error("unknown-key", c.pos(it.key as YamlNode), `block '${name}': unknown key '${k}'`, {
+        block: name,
+        expected: `one of ${BLOCK_KEYS.join(", ")}`,
+        ...(suggestion !== undefined ? { suggestion } : {}),
+      });
+    }
+  }
+
+  const t = readType(c, name, at, get("Type")?.node, get("Type") !== undefined, catalog);
+  const def = t.def;
+  const desiredRate = readDesiredRate(c, name, at, get("DesiredRate")?.node, def, t.type);
+
+  const inputsEntry = get("Inputs");
+  const inputsPos = inputsEntry ? c.pos(inputsEntry.node as YamlNode) : at;
+  const inputs = inputsEntry ? readInputs(c, name, inputsEntry.node, inputsPos) : [];
+
+  let path: string | undefined;
+  const pathEntry = get("Path");
+  if (pathEntry) path = readPath(c, name, pathEntry.node);
+
+  let worker = "main";
+  const workerEntry = get("Worker");
+  if (workerEntry) worker = readWorker(c, name, workerEntry.node) ?? worker;
+
+  const batchingEntry = get("BatchingMs");
+  const batchingMs = batchingEntry ? readBatchingMs(c, batchingEntry.node, name) : undefined;
+
+  const queueEntry = get("Queue");
+  const queue = queueEntry
+    ? readQueue(c, name, queueEntry.node)
+    : { policy: "drop-oldest" as QueuePolicy, capacity: undefined };
+
+  const layoutEntry = get("Layout");
+  const layout = layoutEntry ? readLayout(c, name, layoutEntry.node) : undefined;
+
+  const paramsEntry = get("Params");
+  return {
+    def,
+    type: t.type,
+    written: t.written,
+    typePos: t.pos,
+    renamed: def !== undefined && t.written !== def.type,
+    desiredRate,
+    inputs,
+    inputsPos,
+    path,
+    worker,
+    batchingMs,
+    queue,
+    layout,
+    paramsNode: paramsEntry?.node,
+    paramsPos: paramsEntry ? c.pos(paramsEntry.node as YamlNode) : at,
+  };
+}
+
+interface TypeResult {
+  def: AnyBlockDefinition | undefined;
+  type: string;
+  written: string | undefined;
+  pos: SourcePos;
+}
+
+/** Type: the catalog's name or alias. */
+export function readType(
+  c: Collector,
+  name: string,
+  at: SourcePos,
+  node: unknown,
+  present: boolean,
+  catalog: Catalog,
+): TypeResult {
+  if (!present) {
+    c.error("missing-type", at, `block '${name}' has no Type`, {
+      block: name,
+      expected: "`Type: <block type>`, e.g. `Type: Filter`",
+    });
+    return { def: undefined, type: "", written: undefined, pos: at };
+  }
+  const pos = c.pos(node as YamlNode);
+  const t = scalarString(node);
+  if (t === undefined || t === "") {
+    c.error("bad-type", pos, `block '${name}': Type is ${describeNode(node)}`, {
+      block: name,
+      expected: "the name of a block type",
+    });
+    return { def: undefined, type: "", written: undefined, pos };
+  }
+  const def = catalog.get(t);
+  if (def) return { def, type: def.type, written: t, pos };
+  const typeNames = [...catalog].filter(([n, d]) => n === d.type).map(([n]) => n);
+  const suggestion = closest(t, typeNames);
+  c.error("unknown-type", pos, `block '${name}': unknown block type '${t}'`, {
+    block: name,
+    ...(suggestion !== undefined
+      ? { suggestion }
+      : { expected: "a type listed in docs/blocks.md" }),
+  });
+  return { def: undefined, type: t, written: t, pos };
+}
+
+function readDesiredRate(
+  c: Collector,
+  name: string,
+  at: SourcePos,
+  node: unknown,
+  def: AnyBlockDefinition | undefined,
+  type: string,
+): number | undefined {
+  if (node !== undefined) {
+    const v = isScalar(node) ? node.value : undefined;
+    if (typeof v === "number" && Number.isFinite(v) && v > 0) return v;
+    c.error(
+      "bad-rate",
+      c.pos(node as YamlNode),
+      `block '${name}': DesiredRate has ${describeNode(node)}`,
+      {
+        block: name,
+        expected: "a positive number of Hz",
+      },
+    );
+    return undefined;
+  }
+  if (def && (def.timer || def.requiresRate)) {
+    c.error("missing-rate", at, `block '${name}' (${type}) needs a DesiredRate`, {
+      block: name,
+      expected: "`DesiredRate: <Hz>`",
+    });
+  }
+  return undefined;
+}
+
+function readInputs(c: Collector, name: string, node: unknown, inputsPos: SourcePos): InputRef[] {
+  const inputs: InputRef[] = [];
+  if (isNullish(node)) return inputs;
+  const items: unknown[] = isSeq(node) ? node.items : isScalar(node) ? [node] : [];
+  if (!isSeq(node) && !isScalar(node)) {
+    c.error("bad-inputs", inputsPos, `block '${name}': Inputs is ${describeNode(node)}`, {
+      block: name,
+      expected: "a list of block names, e.g. `Inputs: [Timer]`",
+    });
+  }
+  for (const item of items) {
+    const s = scalarString(item);
+    const ipos = c.pos(item as YamlNode);
+    if (s === undefined || s === "" || s === "-") {
+      c.error("bad-input", ipos, `block '${name}': an input is ${describeNode(item)}`, {
+        block: name,
+        expected: "a block name, or -Name to declare it without subscribing",
+      });
+      continue;
+    }
+    const subscribed = !s.startsWith("-");
+    const ref = subscribed ? s : s.slice(1);
+    const dot = ref.indexOf(".");
+    inputs.push({
+      source: ref,
+      block: dot < 0 ? ref : ref.slice(0, dot),
+      port: dot < 0 ? "" : ref.slice(dot + 1),
+      subscribed,
+      pos: ipos,
+    });
+  }
+  return inputs;
+}
+
+function readPath(c: Collector, name: string, node: unknown): string | undefined {
+  const s = isScalar(node) && typeof node.value === "string" ? node.value : undefined;
+  if (s !== undefined && s.trim() !== "") return s;
+  c.error("bad-path", c.pos(node as YamlNode), `block '${name}': Path is ${describeNode(node)}`, {
+    block: name,
+    expected: "a folder (the log is <Path>/<block>.txt) or a file name",
+  });
+  return undefined;
+}
+
+function readWorker(c: Collector, name: string, node: unknown): string | undefined {
+  const s = scalarString(node);
+  if (s !== undefined && WORKER_RE.test(s)) return s;
+  c.error(
+    "bad-worker",
+    c.pos(node as YamlNode),
+    `block '${name}': Worker is ${describeNode(node)}`,
+    {
+      block: name,
+      expected: "a worker name (a plain word); blocks with the same name share a thread",
+    },
+  );
+  return undefined;
+}
+
+function readQueue(c: Collector, name: string, qn: unknown): QueueSpec {
+  const queue: QueueSpec = { policy: "drop-oldest", capacity: undefined };
+  if (!isMap(qn)) {
+    c.error("bad-queue", c.pos(qn as YamlNode), `block '${name}': Queue is ${describeNode(qn)}`, {
+      block: name,
+      expected: "`{ Policy: drop-oldest | drop-newest | latest, Capacity: <events> }`",
+    });
+    return queue;
+  }
+  for (const it of qn.items) {
+    const k = scalarString(it.key) ?? "";
+    const vpos = c.pos((it.value as YamlNode | null) ?? (it.key as YamlNode));
+    if (k === "Policy") {
+      const v = scalarString(it.value) ?? "";
+      if ((QUEUE_POLICIES as readonly string[]).includes(v)) queue.policy = v as QueuePolicy;
+      else {
+        const suggestion = closest(v, QUEUE_POLICIES);
+        c.error("bad-queue", vpos, `block '${name}': Queue.Policy '${v}' is not a policy`, {
+          block: name,
+          param: "Queue.Policy",
+          expected: `one of ${QUEUE_POLICIES.join(", ")}`,
+          ...(suggestion !== undefined ? { suggestion } : {}),
+        });
+      }
+    } else if (k === "Capacity") {
+      const v = isScalar(it.value) ? it.value.value : undefined;
+      if (typeof v === "number" && Number.isInteger(v) && v >= 1 && v <= 1 << 24)
+        queue.capacity = v;
+      else
+        c.error(
+          "bad-queue",
+          vpos,
+          `block '${name}': Queue.Capacity has ${describeNode(it.value)}`,
+          {
+            block: name,
+            param: "Queue.Capacity",
+            expected: "a whole number of events between 1 and 16777216",
+          },
+        );
+    } else {
+      const suggestion = closest(k, ["Policy", "Capacity"]);
+      c.error("bad-queue", c.pos(it.key as YamlNode), `block '${name}': unknown Queue key '${k}'`, {
+        block: name,
+        expected: "Policy or Capacity",
+        ...(suggestion !== undefined ? { suggestion } : {}),
+      });
+    }
+  }
+  return queue;
+}
+
+function readLayout(c: Collector, name: string, ln: unknown): { x: number; y: number } | undefined {
+  const xs = isMap(ln) ? ln.get("X") : undefined;
+  const ys = isMap(ln) ? ln.get("Y") : undefined;
+  if (
+    typeof xs === "number" &&
+    typeof ys === "number" &&
+    Number.isFinite(xs) &&
+    Number.isFinite(ys)
+  )
+    return { x: xs, y: ys };
+  c.error("bad-layout", c.pos(ln as YamlNode), `block '${name}': Layout is ${describeNode(ln)}`, {
+    block: name,
+    expected: "`{ X: <number>, Y: <number> }`",
+  });
+  return undefined;
+}
+
+/** `Pipeline: { … }` without a `Type` is the settings entry (a block may still be named Pipeline). */
+export function isSettingsEntry(name: string | undefined, value: unknown): boolean {
+  return (
+    name === SETTINGS_KEY &&
+    isMap(value) &&
+    !value.items.some((it) => scalarString(it.key) === "Type")
+  );
+}
+
+/** The settings entry `Pipeline: { BatchingMs }`. */
+export function readSettings(c: Collector, node: YAMLMap, settings: PipelineSettings): void {
+  for (const it of node.items) {
+    const k = scalarString(it.key) ?? "";
+    if (k === "BatchingMs") {
+      settings.batchingMs = readBatchingMs(c, it.value, undefined);
+      continue;
+    }
+    const suggestion = closest(k, SETTINGS_KEYS);
+    c.error("unknown-key", c.pos(it.key as YamlNode), `${SETTINGS_KEY}: unknown setting '${k}'`, {
+      expected: `one of ${SETTINGS_KEYS.join(", ")} (a block named ${SETTINGS_KEY} needs a Type)`,
+      ...(suggestion !== undefined ? { suggestion } : {}),
+    });
+  }
+}
+
+/** `BatchingMs`: a number of milliseconds, 0 (a wake-up per tick) to 1000. */
+export function readBatchingMs(
+  c: Collector,
+  node: unknown,
+  block: string | undefined,
+): number | undefined {
+  const v = isScalar(node) ? node.value : undefined;
+  if (typeof v === "number" && Number.isFinite(v) && v >= 0 && v <= 1000) return v;
+  c.error(
+    "bad-batching",
+    c.pos(node as YamlNode),
+    `${block !== undefined ? `block '${block}'` : SETTINGS_KEY}: BatchingMs has ${describeNode(node)}`,
+    {
+      ...(block !== undefined ? { block } : {}),
+      expected: "milliseconds from 0 (wake up for every tick) to 1000, e.g. `BatchingMs: 2`",
+    },
+  );
+  return undefined;
+}

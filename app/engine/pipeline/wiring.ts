@@ -1,0 +1,76 @@
+/**
+ * Loader stage 5, wiring: every input names a block of the pipeline (and one of its output
+ * ports), and every block has as many inputs as its type takes. Resolves each input's default
+ * port.
+ */
+import { closest } from "../suggest";
+import type { Collector } from "./collector";
+import type { BlockSpec } from "./spec";
+
+/**
+ * Stage 5. `allNames`: every top-level name of the file, so that an input naming a block that
+ * has its own error is not reported a second time.
+ */
+export function checkWiring(
+  c: Collector,
+  blocks: readonly BlockSpec[],
+  byName: ReadonlyMap<string, BlockSpec>,
+  allNames: readonly string[],
+): void {
+  for (const b of blocks) {
+    for (const inp of b.inputs) {
+      const src = byName.get(inp.block);
+      if (!src) {
+        if (allNames.includes(inp.block)) continue; // that block has its own error already
+        const suggestion = closest(inp.block, allNames);
+        c.error(
+          "missing-input",
+          inp.pos,
+          `block '${b.name}': input '${inp.block}' is not a block in this pipeline`,
+          {
+            block: b.name,
+            ...(suggestion !== undefined
+              ? { suggestion }
+              : { expected: `one of ${allNames.join(", ")}` }),
+          },
+        );
+        continue;
+      }
+      if (inp.port === "") {
+        inp.port = src.outputs[0] ?? "out";
+      } else if (!src.outputs.includes(inp.port)) {
+        const suggestion = closest(inp.port, src.outputs);
+        c.error(
+          "missing-port",
+          inp.pos,
+          `block '${b.name}': '${inp.block}' has no output '${inp.port}'`,
+          {
+            block: b.name,
+            expected: `one of ${src.outputs.map((o) => `${inp.block}.${o}`).join(", ")}`,
+            ...(suggestion !== undefined ? { suggestion: `${inp.block}.${suggestion}` } : {}),
+          },
+        );
+      }
+    }
+    const n = b.inputs.length;
+    const { min, max } = b.def.inputs;
+    if (n < min || n > max) {
+      const want =
+        min === max
+          ? `exactly ${min}`
+          : max === Infinity
+            ? `at least ${min}`
+            : `between ${min} and ${max}`;
+      const labels = b.def.inputs.labels ? ` (${b.def.inputs.labels.join(", ")})` : "";
+      c.error(
+        "input-count",
+        b.inputsPos,
+        `block '${b.name}' (${b.type}) has ${n} input${n === 1 ? "" : "s"}`,
+        {
+          block: b.name,
+          expected: `${want} input${max === 1 ? "" : "s"}${labels}`,
+        },
+      );
+    }
+  }
+}
