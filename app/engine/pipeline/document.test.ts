@@ -1,11 +1,11 @@
 import { readdirSync, readFileSync, statSync } from "node:fs";
 import { join } from "node:path";
 import fc from "fast-check";
-import { parseDocument } from "yaml";
 import { describe, expect, it } from "vitest";
 import type { Catalog } from "../catalog";
 import { testCatalog } from "../test-blocks";
 import { DocumentHistory, PipelineDocument, flowYaml, referencedBlock } from "./document";
+import { parsePipelineYaml } from "./parse";
 
 const ROOT = join(__dirname, "../../..");
 const FIXTURES = join(__dirname, "fixtures");
@@ -73,8 +73,7 @@ function changedLines(a: string, b: string): number[] {
  * the checks that the loader accepts the edited files with the real catalog are in
  * tests/integration/format.test.ts.
  */
-const errorsOf = (text: string, _file = "p.yaml") =>
-  parseDocument(text, { uniqueKeys: true }).errors;
+const errorsOf = (text: string, _file = "p.yaml") => parsePipelineYaml(text).doc.errors;
 /** Function's positional form, as app/blocks/signal/function.ts converts it (enough for the test). */
 const catalog = new Map([
   [
@@ -131,7 +130,9 @@ describe("PipelineDocument: round trip", () => {
           // Every other block reads the same.
           for (const o of doc.blockNames()) if (o !== b) expect(d.block(o)).toEqual(doc.block(o));
           d.setParam(b, k, v);
-          expect(parseDocument(d.toString()).toJS()).toEqual(parseDocument(c.text).toJS());
+          expect(parsePipelineYaml(d.toString()).doc.toJS()).toEqual(
+            parsePipelineYaml(c.text).doc.toJS(),
+          );
           tried++;
         }
       }
@@ -212,8 +213,8 @@ describe("PipelineDocument: round trip", () => {
         }
         expect(r.lastDropped).toEqual(dropped);
         // The result is valid YAML whose other blocks are untouched unless they lost an input.
-        const js = parseDocument(r.toString()).toJS() as Record<string, unknown>;
-        const js0 = parseDocument(c.text).toJS() as Record<string, unknown>;
+        const js = parsePipelineYaml(r.toString()).doc.toJS() as Record<string, unknown>;
+        const js0 = parsePipelineYaml(c.text).doc.toJS() as Record<string, unknown>;
         for (const o of r.blockNames()) {
           if (!dropped.some((x) => x.block === o)) expect(js[o]).toEqual(js0[o]);
         }
@@ -344,7 +345,9 @@ describe("PipelineDocument: edits on a commented file", () => {
       "  Type: Sink",
       "  DesiredRate: 5",
     ]);
-    const js = parseDocument(d.toString()).toJS() as { A: { Params: Record<string, unknown> } };
+    const js = parsePipelineYaml(d.toString()).doc.toJS() as {
+      A: { Params: Record<string, unknown> };
+    };
     expect(js.A.Params).toEqual({
       X: 1,
       S: "a, b: #c",
@@ -550,7 +553,7 @@ describe("PipelineDocument: random edit sequences (fast-check)", () => {
         const d = PipelineDocument.parse(c.text, c.name);
         for (const o of ops) {
           const before = d.toString();
-          const js0 = parseDocument(before).toJS() as Record<string, unknown>;
+          const js0 = parsePipelineYaml(before).doc.toJS() as Record<string, unknown>;
           try {
             run(d, o);
           } catch (e) {
@@ -568,7 +571,7 @@ describe("PipelineDocument: random edit sequences (fast-check)", () => {
           ).toEqual([]);
           expect(PipelineDocument.parse(after, c.name).toString()).toBe(after);
           // Blocks the edit is not about read the same as before.
-          const js = parseDocument(after).toJS() as Record<string, unknown>;
+          const js = parsePipelineYaml(after).doc.toJS() as Record<string, unknown>;
           const about = new Set([o.n, "to" in o ? o.to : ""]);
           for (const [k, v] of Object.entries(js0)) {
             if (about.has(k) || !(k in js)) continue;

@@ -180,7 +180,10 @@ function checkFinite(v: number, what: string): void {
   }
 }
 
-/** Parses the text as the loader does (parse.ts). */
+/**
+ * Parses the text as the loader does (parse.ts: MOSAIC's multi-line flow layouts are read through
+ * an offset-keeping pre-pass, so node ranges index `text` as it is).
+ */
 function parseText(text: string): Document {
   const { doc } = parsePipelineYaml(text);
   if (doc.errors.length === 0) {

@@ -2,7 +2,7 @@
  * Pipeline loader: YAML text → validated PipelineSpec, or diagnostics that name file, line,
  * column, block and parameter (DESIGN.md §2). Never throws on bad input. Its stages, one module
  * each:
- * 1. parse (parse.ts): text → `yaml` Document;
+ * 1. parse (parse.ts, with the layout pre-pass of yaml-compat.ts): text → `yaml` Document;
  * 2. block keys (keys.ts): Type, DesiredRate, Inputs, Path, Worker, BatchingMs, Queue, Layout,
  *    and the `Pipeline:` settings;
  * 3. params (params.ts): zod, MOSAIC's positional form converted first (positional.ts);

@@ -1,20 +1,32 @@
 /**
  * Loader stage 1, parse: YAML text → `yaml` Document (comments and node ranges kept) and a line
  * counter over the text as written; a syntax error becomes one positioned diagnostic.
+ *
+ * A file `yaml` rejects is parsed once more after the pre-pass of yaml-compat.ts (the layout of
+ * multi-line flow collections the original MOSAIC accepted). The pre-pass keeps every offset, so
+ * node ranges index the file as written and the editor (document.ts) edits it as it is. Files
+ * that parse as they are never see the pre-pass.
  */
 import { LineCounter, parseDocument, type Document } from "yaml";
 import { Collector } from "./collector";
 import type { SourcePos } from "./spec";
+import { relaxFlowLayout, type LayoutFix } from "./yaml-compat";
 
 export interface ParsedYaml {
   doc: Document;
+  /** Fixes the pre-pass needed (none when the file parsed as it is). */
+  fixes: LayoutFix[];
 }
 
 const OPTIONS = { uniqueKeys: true, prettyErrors: false } as const;
 
-/** Parses pipeline YAML the way the loader and the editor do. */
+/** Parses pipeline YAML the way the loader and the editor do (see the file comment). */
 export function parsePipelineYaml(source: string): ParsedYaml {
-  return { doc: parseDocument(source, OPTIONS) };
+  const doc = parseDocument(source, OPTIONS);
+  if (doc.errors.length === 0) return { doc, fixes: [] };
+  const relaxed = relaxFlowLayout(source);
+  if (relaxed.fixes.length === 0) return { doc, fixes: [] };
+  return { doc: parseDocument(relaxed.text, OPTIONS), fixes: relaxed.fixes };
 }
 
 /** A line counter over `source` (1-based lines and columns for offsets). */
