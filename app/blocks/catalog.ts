@@ -26,6 +26,7 @@ import { Switch } from "./flow/switch";
 import { VectorialFunction } from "./flow/vectorial-function";
 import { Ros } from "./io/ros";
 import { Myo } from "./io/myo";
+import { BlenderArm } from "./io/blender-arm";
 import { Python } from "./io/python";
 import { SerialPort } from "./io/serial-port";
 import { UdpReceiver } from "./io/udp-receiver";
@@ -103,6 +104,7 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   SerialPort,
   Myo,
   Ros,
+  BlenderArm,
   // Recording
   Logger,
   // Testing

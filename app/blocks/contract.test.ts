@@ -427,6 +427,11 @@ const SETUPS: Record<string, Setup | Setup[]> = {
     { params: {}, inputs: [timer(200)], io: quietMyo },
     { params: { Address: "AA:BB:CC:DD:EE:01", EMG: "raw", IMU: false }, inputs: [], io: quietMyo },
   ],
+  BlenderArm: [
+    { params: { Port: 9 }, inputs: [vec(11)], io: recordingUdp },
+    { params: { Port: 9 }, inputs: [vec(12)], io: recordingUdp },
+    { params: { Port: 9, Input: "command" }, inputs: [vec(9)] },
+  ],
   // A source fed by its socket: nothing to feed here (tests/integration/udp.test.ts runs it).
   UdpReceiver: { params: { Port: 9, Channels: 3 }, inputs: [] },
   SerialPort: [

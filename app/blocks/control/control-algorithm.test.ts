@@ -119,6 +119,47 @@ describe("ControlAlgorithm", () => {
     );
   });
 
+  test("MOSAIC's mapping fed with 12 predictions: the missing degrees stay at rest, one warning", async () => {
+    const catalog = createCatalog([ControlAlgorithm]);
+    const r = loadPipeline(
+      "C: { Type: ControlAlgorithm, Inputs: [C], Params: [ 'algorithm: DirectControl' ] }\n",
+      "p.yaml",
+      catalog,
+    );
+    const h = await harness(r.spec!.blocks[0]!.params, 12);
+    expect(h.warnings).toEqual([
+      "input 'in0' has 12 predictions; at rest (no prediction): ElbowFlexion (13), ElbowExtension (14)",
+    ]);
+    // power grasp with wrist extension 0.5 and supination 1, ulnar 0.25
+    h.push(preds([0], [[1, 1, 1, 1, 1, 1, 0, 0.5, 0, 1, 0.25, 0]]));
+    // DOAs order: 6 fingers, flexion/extension, ulnar/radial, pronation/supination, elbows.
+    expect(h.output().v).toEqual([[100, 100, 100, 100, 100, 100, 75, 62.5, 0, 0, 0]]);
+    expect(h.warnings).toHaveLength(1);
+
+    // Stepwise: prediction 12 (open) drives the fingers down; with 12 predictions it is absent.
+    const s = loadPipeline(
+      "C: { Type: ControlAlgorithm, Inputs: [C], Params: [ algorithm:StepwiseControl ] }\n",
+      "p.yaml",
+      catalog,
+    );
+    const hs = await harness(s.spec!.blocks[0]!.params, 13);
+    expect(hs.warnings[0]).toMatch(/13 predictions; at rest .*ElbowFlexion \(13\)/);
+    // One second at full thumb flexion, then 0.5 s of "open" at 1: 70·(1−0.3)/0.7 per second.
+    hs.push(
+      preds(
+        [0, 1, 1.5],
+        [
+          [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0],
+          [1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0],
+          [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1],
+        ],
+      ),
+    );
+    const v = hs.output().v;
+    expect(v[1]![0]).toBeCloseTo(70, 12);
+    expect(v[2]![0]).toBeCloseTo(35, 12);
+  });
+
   test("MOSAIC's positional form loads with its hand mapping", () => {
     const catalog = createCatalog([ControlAlgorithm]);
     const r = loadPipeline(

@@ -8,6 +8,7 @@ import {
 } from "../../engine";
 import { vectorInput } from "../shared/inputs";
 import { extendedNumber } from "../shared/params";
+import { A, DOAS } from "./actuation";
 
 /**
  * Strategies behind one interface (paper III-H): both turn one prediction vector into the next
@@ -58,26 +59,41 @@ const dof = z.strictObject({
 
 type DofSpec = z.output<typeof dof>;
 
-/** MOSAIC's 15-prediction hand mapping (its DirectControl/StepwiseControl), as DoF specs. */
-export function mosaicHandDofs(): DofSpec[] {
-  const finger = (name: string, i: number): DofSpec => ({
-    Name: name,
+/**
+ * MOSAIC's hand mapping (its DirectControlStrategy.cs / StepwiseControlStrategy.cs) as DoF specs,
+ * in the order of its DOAs enum (actuation.ts): fingers from predictions 0–5, the wrist axes from
+ * the differences 7 − 6 (extension − flexion), 10 − 11 (ulnar − radial) and 8 − 9 (pronation −
+ * supination) around 50, elbow flexion and extension from 13 and 14. Stepwise control also closes
+ * the fingers with prediction 12 ("open hand"), as the original's; direct control ignores it, as
+ * the original's did.
+ */
+export function mosaicHandDofs(strategy: "direct" | "stepwise" = "direct"): DofSpec[] {
+  const open = strategy === "stepwise" ? { Negative: 12 } : {};
+  const finger = (i: number): DofSpec => ({
+    Name: DOAS[i]!.name,
     Positive: i,
-    Negative: 12,
+    ...open,
     Rest: 0,
   });
+  const axis = (k: number, plus: number, minus: number): DofSpec => ({
+    Name: DOAS[k]!.name,
+    Positive: plus,
+    Negative: minus,
+    Rest: 50,
+    Gain: 50,
+  });
   return [
-    finger("ThumbFlexion", 0),
-    finger("ThumbRotation", 1),
-    finger("Index", 2),
-    finger("Middle", 3),
-    finger("Ring", 4),
-    finger("Little", 5),
-    { Name: "WristFlexionExtension", Positive: 7, Negative: 6, Rest: 50, Gain: 50 },
-    { Name: "WristPronationSupination", Positive: 8, Negative: 9, Rest: 50, Gain: 50 },
-    { Name: "WristUlnarRadialDeviation", Positive: 10, Negative: 11, Rest: 50, Gain: 50 },
-    { Name: "ElbowFlexion", Positive: 13, Rest: 0 },
-    { Name: "ElbowExtension", Positive: 14, Rest: 0 },
+    finger(0),
+    finger(1),
+    finger(2),
+    finger(3),
+    finger(4),
+    finger(5),
+    axis(A.WristFlexionExtension, 7, 6),
+    axis(A.WristUlnarRadialDeviation, 10, 11),
+    axis(A.WristPronationSupination, 8, 9),
+    { Name: DOAS[A.ElbowFlexion]!.name, Positive: 13, Rest: 0 },
+    { Name: DOAS[A.ElbowExtension]!.name, Positive: 14, Rest: 0 },
   ];
 }
 
@@ -108,6 +124,14 @@ const params = z
       .min(0)
       .default(0)
       .describe("Activations at or below this are treated as zero (and the rest starts from zero)"),
+    MissingPredictions: z
+      .enum(["error", "rest"])
+      .default("error")
+      .describe(
+        "A DoF whose Positive index is beyond the input's predictions: error (at load), or rest " +
+          "(it stays at Rest, and a missing Negative is left out; one warning at load says which), " +
+          "e.g. MOSAIC's 15-prediction mapping fed with 12 or 13 predictions",
+      ),
     Min: z.number().default(0).describe("Lowest output value"),
     Max: z.number().default(100).describe("Highest output value"),
     SlewRate: extendedNumber()
@@ -151,7 +175,15 @@ export const ControlAlgorithm = defineBlock({
     "second and clipped to [Min, Max]. A watchdog sends the Safe output when no prediction arrived " +
     "for Timeout seconds (a stalled model must not leave a prosthesis moving). MOSAIC's " +
     "`[algorithm:DirectControl]` and `[algorithm:StepwiseControl]` load with its 15-prediction hand " +
-    "mapping (11 DoFs, 0–100, wrist at 50).",
+    "mapping: 11 DoFs, 0–100, in the order of its DOAs enum (ThumbFlexion, ThumbRotation, Index, " +
+    "Middle, Ring, Little, WristFlexionExtension, WristUlnarRadialDeviation, " +
+    "WristPronationSupination, ElbowFlexion, ElbowExtension; wrist axes at 50), the vector that " +
+    "BlenderArm, HannesHand and HannesGUI read. Its predictions 12 (open hand, stepwise only), 13 " +
+    "and 14 (elbow) are often absent: the examples' models predict 12 or 13 values, which made the " +
+    "original fail on every prediction; here the missing degrees stay at rest (one warning at " +
+    "load). Unlike the original, values are not truncated to whole numbers, stepwise control also " +
+    "moves ulnar/radial deviation and elbow extension, and both strategies turn the wrist the same " +
+    "way (the original's stepwise pronation/supination ran opposite to its direct control).",
   params,
   legacyParams: (args) => {
     const p = legacyPair(args[0] ?? "");
@@ -161,21 +193,33 @@ export const ControlAlgorithm = defineBlock({
         "Strategy",
       );
     }
-    if (p.value === "DirectControl")
-      return { Strategy: "direct", DoFs: mosaicHandDofs(), Gain: 100, Min: 0, Max: 100 };
-    if (p.value === "StepwiseControl") {
-      // MOSAIC stepped by 100/25 per prediction at 25 Hz with a 0.3 dead band: 100 per second.
+    // The enum parse of the original tolerated spaces around the name.
+    const algorithm = p.value.trim();
+    if (algorithm === "DirectControl") {
+      return {
+        Strategy: "direct",
+        DoFs: mosaicHandDofs("direct"),
+        Gain: 100,
+        Min: 0,
+        Max: 100,
+        MissingPredictions: "rest",
+      };
+    }
+    if (algorithm === "StepwiseControl") {
+      // MOSAIC stepped by (p − 0.3)·100/25 per prediction (at 25 Hz: 100·(p − 0.3) per second);
+      // here activations above the 0.3 dead zone are rescaled by 1/0.7, hence a gain of 70.
       return {
         Strategy: "stepwise",
-        DoFs: mosaicHandDofs().map((d) => ({ ...d, Gain: 100 })),
-        Gain: 100,
+        DoFs: mosaicHandDofs("stepwise").map((d) => ({ ...d, Gain: 70 })),
+        Gain: 70,
         DeadZone: 0.3,
         Min: 0,
         Max: 100,
+        MissingPredictions: "rest",
       };
     }
     throw new LegacyParamsError(
-      `unknown algorithm '${p.value}' (MOSAIC had DirectControl and StepwiseControl)`,
+      `unknown algorithm '${algorithm}' (MOSAIC had DirectControl and StepwiseControl)`,
       "Strategy",
     );
   },
@@ -190,12 +234,19 @@ export const ControlAlgorithm = defineBlock({
     const dofs: DofSpec[] =
       p.DoFs ??
       Array.from({ length: width }, (_, k) => ({ Name: `dof${k}`, Positive: k, Rest: 0 }));
+    const atRest: string[] = [];
+    const oneSided: string[] = [];
     dofs.forEach((d, i) => {
       for (const [key, idx] of [
         ["Positive", d.Positive],
         ["Negative", d.Negative],
       ] as const) {
         if (idx !== undefined && idx >= width) {
+          if (p.MissingPredictions === "rest") {
+            if (key === "Positive") atRest.push(`${d.Name} (${idx})`);
+            else if (d.Positive < width) oneSided.push(`${d.Name} (${idx})`);
+            continue;
+          }
           throw new BlockConfigError(
             `DoFs[${i}] (${d.Name}): ${key} ${idx} is out of range for input '${input.info.source}' with ${width} predictions (valid: 0–${width - 1})`,
             "DoFs",
@@ -203,12 +254,22 @@ export const ControlAlgorithm = defineBlock({
         }
       }
     });
+    if (atRest.length > 0 || oneSided.length > 0) {
+      ctx.warn(
+        `input '${input.info.source}' has ${width} predictions` +
+          (atRest.length > 0 ? `; at rest (no prediction): ${atRest.join(", ")}` : "") +
+          (oneSided.length > 0 ? `; driven one way only: ${oneSided.join(", ")}` : ""),
+      );
+    }
     const m = dofs.length;
     if (Array.isArray(p.Safe) && p.Safe.length !== m) {
       throw new BlockConfigError(`Safe has ${p.Safe.length} values for ${m} DoFs`, "Safe");
     }
-    const pos = Int32Array.from(dofs, (d) => d.Positive);
-    const neg = Int32Array.from(dofs, (d) => d.Negative ?? -1);
+    // -1: no prediction (MissingPredictions: rest).
+    const pos = Int32Array.from(dofs, (d) => (d.Positive < width ? d.Positive : -1));
+    const neg = Int32Array.from(dofs, (d) =>
+      d.Negative !== undefined && d.Negative < width ? d.Negative : -1,
+    );
     const rest = Float64Array.from(dofs, (d) => d.Rest);
     const lo = Float64Array.from(dofs, (d) => d.Min ?? p.Min);
     const hi = Float64Array.from(dofs, (d) => d.Max ?? p.Max);
@@ -235,6 +296,10 @@ export const ControlAlgorithm = defineBlock({
     const direct: Strategy = {
       step(pred, off, _dt, _cur, out) {
         for (let i = 0; i < m; i++) {
+          if (pos[i]! < 0) {
+            out[i] = rest[i]!;
+            continue;
+          }
           const up = activation(pred[off + pos[i]!]!, i);
           const down = neg[i]! >= 0 ? activation(pred[off + neg[i]!]!, i) : 0;
           out[i] = rest[i]! + gain[i]! * (up - down);
@@ -244,6 +309,10 @@ export const ControlAlgorithm = defineBlock({
     const stepwise: Strategy = {
       step(pred, off, dt, cur, out) {
         for (let i = 0; i < m; i++) {
+          if (pos[i]! < 0) {
+            out[i] = rest[i]!;
+            continue;
+          }
           const up = activation(pred[off + pos[i]!]!, i);
           const down = neg[i]! >= 0 ? activation(pred[off + neg[i]!]!, i) : 0;
           out[i] = cur[i]! + gain[i]! * (up - down) * dt;
