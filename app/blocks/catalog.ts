@@ -34,6 +34,7 @@ import { UdpSender } from "./io/udp-sender";
 import { BatchPredictor } from "./learning/batch-predictor";
 import { IncrementalPredictor } from "./learning/incremental-predictor";
 import { Stimulus } from "./learning/stimulus";
+import { StimTrigger } from "./learning/stim-trigger";
 import { TAC } from "./learning/tac";
 import { Trigger } from "./learning/trigger";
 import { Logger } from "./recording/logger";
@@ -92,6 +93,7 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   // Learning
   Trigger,
   Stimulus,
+  StimTrigger,
   TAC,
   BatchPredictor,
   IncrementalPredictor,

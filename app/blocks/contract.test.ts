@@ -525,6 +525,11 @@ const SETUPS: Record<string, Setup | Setup[]> = {
       pattern: [0, 0, 0, 1],
     },
   ],
+  StimTrigger: {
+    params: {},
+    inputs: [vec(2, 0)],
+    values: (i) => (i % 4 === 3 ? [NaN, NaN] : [1, i % 2]),
+  },
   TAC: [
     {
       params: {
