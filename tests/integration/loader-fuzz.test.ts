@@ -24,6 +24,8 @@ function pipelineFiles(): { file: string; text: string }[] {
     }
   };
   walk(join(ROOT, "pipelines"));
+  // Files in the original MOSAIC's layouts: mutations there go through the YAML pre-pass.
+  walk(join(ROOT, "tests/fixtures/mosaic-original"));
   return out;
 }
 

@@ -9,6 +9,8 @@ import { parsePipelineYaml } from "./parse";
 
 const ROOT = join(__dirname, "../../..");
 const FIXTURES = join(__dirname, "fixtures");
+/** Our own files in the original MOSAIC's layouts (tests/integration/mosaic-original.test.ts). */
+const MOSAIC_FIXTURES = join(ROOT, "tests/fixtures/mosaic-original");
 
 function yamlFiles(dir: string): string[] {
   const out: string[] = [];
@@ -52,6 +54,10 @@ const CASES: Case[] = [
   ...readdirSync(FIXTURES)
     .filter((f) => f.endsWith(".yaml"))
     .map((f) => ({ name: `fixtures/${f}`, text: readFileSync(join(FIXTURES, f), "utf8") })),
+  ...yamlFiles(MOSAIC_FIXTURES).map((f) => ({
+    name: f.slice(ROOT.length),
+    text: readFileSync(f, "utf8"),
+  })),
   ...Object.entries(INLINE).map(([name, text]) => ({ name: `inline/${name}`, text })),
 ];
 /** Every case once more with CRLF line endings (kept as they are: new lines use CRLF too). */

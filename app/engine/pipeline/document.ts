@@ -33,6 +33,7 @@ import type { Catalog } from "../catalog";
 import { errorMessage, type Diagnostic } from "../diagnostics";
 import { closest } from "../suggest";
 import { BLOCK_NAME_RE, loadPipeline, type LoadResult } from "./loader";
+import { mosaicType } from "./mosaic";
 import { parsePipelineYaml } from "./parse";
 import { positionalArgs } from "./positional";
 
@@ -455,24 +456,41 @@ export class PipelineDocument {
 
   /**
    * Replaces MOSAIC's positional `Params: [...]` of a block with the named mapping the loader
-   * converts it to (the catalog's `legacyParams`). Throws when the block's type is unknown, has
-   * no positional form, or the list does not convert.
+   * converts it to (the catalog's `legacyParams`). A block whose Type is one of the original's
+   * old names (mosaic.ts: `Func_Multiplier`, `TimerDecimator`, …) gets the Type it loads as too,
+   * and a TimerDecimator the DesiredRate the loader computes. Throws when the block's type is
+   * unknown, has no positional form, or the list does not convert; then nothing changes.
    */
   convertLegacyParams(block: string, catalog: Catalog): void {
     const params = this.paramsNode(block);
     if (!isSeq(params)) throw new Error(`the Params of '${block}' are not positional`);
     const type = this.block(block).type ?? "";
-    const def = catalog.get(type);
+    const { lookup, rule } = mosaicType(type, catalog);
+    const def = catalog.get(lookup);
     if (!def) throw new Error(`block '${block}': unknown block type '${type}'`);
     if (!def.legacyParams) throw new Error(`block '${block}': ${def.type} has no positional form`);
-    const args = positionalArgs(params);
+    let args = positionalArgs(params);
     let raw: unknown;
+    let rate: number | undefined;
     try {
+      if (rule?.rateDivisor) {
+        rule.rateDivisor(args);
+        rate = this.load(catalog).spec?.byName.get(block)?.desiredRate;
+        if (rate === undefined)
+          throw new Error(
+            "its DesiredRate comes from its input's, which is not known (the file has errors)",
+          );
+      }
+      if (rule?.args) args = rule.args(args);
       raw = def.legacyParams(args.length === 1 && args[0] === "" ? [] : args);
     } catch (e) {
       throw new Error(`block '${block}': cannot convert its positional Params: ${errorMessage(e)}`);
     }
-    this.apply([this.replaceValueEdit(params, flowYaml(raw))]);
+    this.transaction(() => {
+      this.apply([this.replaceValueEdit(params, flowYaml(raw))]);
+      if (rule) this.setKey(block, "Type", scalarYaml(def.type));
+      if (rate !== undefined) this.setDesiredRate(block, rate);
+    });
   }
 
   /** Sets a block's `Inputs` (kept items keep their spelling; an empty list removes the key). */

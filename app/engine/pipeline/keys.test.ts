@@ -4,6 +4,7 @@ import { formatDiagnostic } from "../diagnostics";
 import { testCatalog } from "../test-blocks";
 import { Collector } from "./collector";
 import { readBlockKeys, readSettings } from "./keys";
+import { mosaicView } from "./mosaic";
 import { lineCounterOf } from "./parse";
 
 /** Stage 3 on block B of `src`. */
@@ -11,7 +12,7 @@ function keys(src: string) {
   const doc = parseDocument(src);
   const map = doc.get("B", true) as YAMLMap;
   const c = new Collector("p.yaml", lineCounterOf(src));
-  const k = readBlockKeys(c, "B", { line: 1, col: 1 }, map, testCatalog);
+  const k = readBlockKeys(c, "B", { line: 1, col: 1 }, map, testCatalog, mosaicView(map));
   return { k, diagnostics: c.list.map(formatDiagnostic) };
 }
 
@@ -51,10 +52,23 @@ describe("block keys stage", () => {
     expect(
       keys("B: { Type: Gain, Path: '' , Worker: 'a b', Queue: { Policy: lates } }\n").diagnostics,
     ).toEqual([
-      "p.yaml:1:24: error: block 'B': Path is the string \"\" (expected a folder (the log is <Path>/<block>.txt) or a file name)",
+      "p.yaml:1:24: warning: block 'B': Path '' logged to the root of the drive in the original MOSAIC; here it logs to B.txt in the log folder (the pipeline's folder, or mosaic run --log-dir)",
       "p.yaml:1:37: error: block 'B': Worker is the string \"a b\" (expected a worker name (a plain word); blocks with the same name share a thread)",
       "p.yaml:1:61: error: block 'B': Queue.Policy 'lates' is not a policy (expected one of drop-oldest, drop-newest, latest); did you mean 'latest'?",
     ]);
+  });
+
+  test("the original's old names and keys: what stage 2 found", () => {
+    const old = keys("B: { Type: Timer, OutputType: 0d }\n");
+    // No Timer in this catalog: the old name maps to ScheduledTimer, which is not there either.
+    expect(old.diagnostics).toEqual([
+      "p.yaml:1:12: error: block 'B': unknown block type 'Timer': 'Timer' is the original MOSAIC's old name of ScheduledTimer, a block that is not available yet",
+    ]);
+    const empty = keys("B: { Type: Gain, Path: '' }\n");
+    expect(empty.k.path).toBe(".");
+    expect(keys("B: { Type: FBGS }\n").diagnostics[0]).toMatch(
+      /no public source of the original MOSAIC defines 'FBGS'/,
+    );
   });
 
   test("Pipeline settings", () => {

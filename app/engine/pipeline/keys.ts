@@ -1,6 +1,6 @@
 /**
  * Loader stage 3, block keys: everything a block says besides its Params — Type (looked up in the
- * catalog), DesiredRate, Inputs, Path, Worker, BatchingMs, Queue and
+ * catalog, through MOSAIC's old names), DesiredRate, Inputs, Path, Worker, BatchingMs, Queue and
  * Layout — and the pipeline's settings (`Pipeline: { BatchingMs }`). Each bad key is one
  * positioned error; the stage never throws.
  */
@@ -9,6 +9,14 @@ import type { AnyBlockDefinition } from "../block";
 import type { Catalog } from "../catalog";
 import { closest } from "../suggest";
 import { Collector, describeNode, isNullish, scalarString } from "./collector";
+import {
+  EMPTY_PATH,
+  emptyPathWarning,
+  mosaicType,
+  unknownTypeNote,
+  type MosaicTypeRule,
+  type MosaicView,
+} from "./mosaic";
 import {
   BLOCK_KEYS,
   QUEUE_POLICIES,
@@ -32,7 +40,9 @@ export interface BlockKeys {
   written: string | undefined;
   /** Where the Type value is. */
   typePos: SourcePos;
-  /** True when the block loads under another name (a block alias). */
+  /** The old name's rule, when `written` is one of MOSAIC_TYPES. */
+  rule: MosaicTypeRule | undefined;
+  /** True when the block loads under another name (a block alias or an old name). */
   renamed: boolean;
   desiredRate: number | undefined;
   inputs: InputRef[];
@@ -54,12 +64,15 @@ export function readBlockKeys(
   at: SourcePos,
   map: YAMLMap,
   catalog: Catalog,
+  view: MosaicView,
 ): BlockKeys {
   const get = (k: string): { node: unknown; keyPos: SourcePos } | undefined => {
     const p = map.items.find((it) => scalarString(it.key) === k);
     return p ? { node: p.value, keyPos: c.pos(p.key as YamlNode) } : undefined;
   };
+  const ignored = new Set(view.ignored.map((p) => p.key));
   for (const it of map.items) {
+    if (ignored.has(it.key)) continue;
     const k = scalarString(it.key) ?? "";
     if (!(BLOCK_KEYS as readonly string[]).includes(k)) {
       const suggestion = closest(k, BLOCK_KEYS);
@@ -72,8 +85,8 @@ export function readBlockKeys(
   }
 
   const t = readType(c, name, at, get("Type")?.node, get("Type") !== undefined, catalog);
-  const def = t.def;
-  const desiredRate = readDesiredRate(c, name, at, get("DesiredRate")?.node, def, t.type);
+  const { def, rule } = t;
+  const desiredRate = readDesiredRate(c, name, at, get("DesiredRate")?.node, def, t.type, rule);
 
   const inputsEntry = get("Inputs");
   const inputsPos = inputsEntry ? c.pos(inputsEntry.node as YamlNode) : at;
@@ -81,7 +94,12 @@ export function readBlockKeys(
 
   let path: string | undefined;
   const pathEntry = get("Path");
-  if (pathEntry) path = readPath(c, name, pathEntry.node);
+  if (pathEntry) {
+    if (pathEntry.node === view.emptyPath && view.emptyPath) {
+      emptyPathWarning(c, name, view.emptyPath);
+      path = EMPTY_PATH;
+    } else path = readPath(c, name, pathEntry.node);
+  }
 
   let worker = "main";
   const workerEntry = get("Worker");
@@ -104,6 +122,7 @@ export function readBlockKeys(
     type: t.type,
     written: t.written,
     typePos: t.pos,
+    rule,
     renamed: def !== undefined && t.written !== def.type,
     desiredRate,
     inputs,
@@ -122,10 +141,11 @@ interface TypeResult {
   def: AnyBlockDefinition | undefined;
   type: string;
   written: string | undefined;
+  rule: MosaicTypeRule | undefined;
   pos: SourcePos;
 }
 
-/** Type: the catalog's name or alias. */
+/** Type: the catalog's name or alias, or one of the original's old names (stage 2's table). */
 export function readType(
   c: Collector,
   name: string,
@@ -139,7 +159,7 @@ export function readType(
       block: name,
       expected: "`Type: <block type>`, e.g. `Type: Filter`",
     });
-    return { def: undefined, type: "", written: undefined, pos: at };
+    return { def: undefined, type: "", written: undefined, rule: undefined, pos: at };
   }
   const pos = c.pos(node as YamlNode);
   const t = scalarString(node);
@@ -148,19 +168,28 @@ export function readType(
       block: name,
       expected: "the name of a block type",
     });
-    return { def: undefined, type: "", written: undefined, pos };
+    return { def: undefined, type: "", written: undefined, rule: undefined, pos };
   }
-  const def = catalog.get(t);
-  if (def) return { def, type: def.type, written: t, pos };
+  const { lookup, rule } = mosaicType(t, catalog);
+  const def = catalog.get(lookup);
+  if (def) return { def, type: def.type, written: t, rule, pos };
+  const note = unknownTypeNote(t, catalog);
   const typeNames = [...catalog].filter(([n, d]) => n === d.type).map(([n]) => n);
-  const suggestion = closest(t, typeNames);
-  c.error("unknown-type", pos, `block '${name}': unknown block type '${t}'`, {
-    block: name,
-    ...(suggestion !== undefined
-      ? { suggestion }
-      : { expected: "a type listed in docs/blocks.md" }),
-  });
-  return { def: undefined, type: t, written: t, pos };
+  const suggestion = note === undefined ? closest(t, typeNames) : undefined;
+  c.error(
+    "unknown-type",
+    pos,
+    `block '${name}': unknown block type '${t}'${note !== undefined ? `: ${note}` : ""}`,
+    {
+      block: name,
+      ...(suggestion !== undefined
+        ? { suggestion }
+        : note === undefined
+          ? { expected: "a type listed in docs/blocks.md" }
+          : {}),
+    },
+  );
+  return { def: undefined, type: t, written: t, rule, pos };
 }
 
 function readDesiredRate(
@@ -170,6 +199,7 @@ function readDesiredRate(
   node: unknown,
   def: AnyBlockDefinition | undefined,
   type: string,
+  rule: MosaicTypeRule | undefined,
 ): number | undefined {
   if (node !== undefined) {
     const v = isScalar(node) ? node.value : undefined;
@@ -185,7 +215,8 @@ function readDesiredRate(
     );
     return undefined;
   }
-  if (def && (def.timer || def.requiresRate)) {
+  // An old TimerDecimator's rate comes from its input's (computed after all blocks are read).
+  if (def && (def.timer || def.requiresRate) && !rule?.rateDivisor) {
     c.error("missing-rate", at, `block '${name}' (${type}) needs a DesiredRate`, {
       block: name,
       expected: "`DesiredRate: <Hz>`",

@@ -3,18 +3,28 @@
  * column, block and parameter (DESIGN.md §2). Never throws on bad input. Its stages, one module
  * each:
  * 1. parse (parse.ts, with the layout pre-pass of yaml-compat.ts): text → `yaml` Document;
- * 2. block keys (keys.ts): Type, DesiredRate, Inputs, Path, Worker, BatchingMs, Queue, Layout,
+ * 2. MOSAIC normalisation (mosaic.ts): the original's old type names, ignored keys, `Path: ''`;
+ * 3. block keys (keys.ts): Type, DesiredRate, Inputs, Path, Worker, BatchingMs, Queue, Layout,
  *    and the `Pipeline:` settings;
- * 3. params (params.ts): zod, MOSAIC's positional form converted first (positional.ts);
- * 4. wiring (wiring.ts): inputs, ports and arity.
+ * 4. params (params.ts): zod, MOSAIC's positional form converted first (positional.ts);
+ * 5. wiring (wiring.ts): inputs, ports and arity.
  * This file walks the top level and hands each block through the stages.
  */
-import { isMap, isScalar, isSeq, type Node as YamlNode, type YAMLMap } from "yaml";
+import { isMap, isScalar, isSeq, type Node as YamlNode, type Pair, type YAMLMap } from "yaml";
 import type { Catalog } from "../catalog";
+import { errorMessage } from "../diagnostics";
 import { Collector, describeNode, scalarString } from "./collector";
 import { isSettingsEntry, readBlockKeys, readSettings } from "./keys";
-import { convertedWarning, paramKeyPositions, readParams } from "./params";
+import {
+  ignoredKeysWarning,
+  mappingMessage,
+  mosaicView,
+  resolvePendingRates,
+  type PendingRate,
+} from "./mosaic";
+import { convertedWarning, paramKeyPositions, paramsText, readParams } from "./params";
 import { lineCounterOf, parseStage } from "./parse";
+import { LegacyParamsError } from "./legacy";
 import { positionalArgs } from "./positional";
 import { BLOCK_NAME_RE, type BlockSpec, type LoadResult, type PipelineSettings } from "./spec";
 import { checkWiring } from "./wiring";
@@ -45,6 +55,8 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
   const blocks: BlockSpec[] = [];
   const byName = new Map<string, BlockSpec>();
   const settings: PipelineSettings = { batchingMs: undefined };
+  const ignoredKeys: { block: string; pair: Pair }[] = [];
+  const pendingRates: PendingRate[] = [];
 
   for (const pair of (root as YAMLMap).items) {
     const keyNode = pair.key as YamlNode | null;
@@ -84,34 +96,68 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
     }
     const errorsBefore = c.errors;
 
-    // Stage 2: the block's keys.
-    const keys = readBlockKeys(c, name, at, value, catalog);
+    // Stage 2: what the original's keys and names mean here.
+    const view = mosaicView(value);
+    for (const p of view.ignored) ignoredKeys.push({ block: name, pair: p });
+
+    // Stage 3: the block's keys.
+    const keys = readBlockKeys(c, name, at, value, catalog, view);
     const def = keys.def;
     if (!def) continue;
 
-    // Stage 3: params, MOSAIC's positional form converted first.
-    const args = isSeq(keys.paramsNode) ? positionalArgs(keys.paramsNode) : undefined;
+    // Stage 4: params, positional ones as the original's blocks read them.
+    const written = isSeq(keys.paramsNode) ? positionalArgs(keys.paramsNode) : undefined;
+    const rule = keys.rule;
+    let args = written;
+    let ruleOk = true;
+    let divisor: number | undefined;
+    if (rule) {
+      try {
+        if (rule.rateDivisor) divisor = rule.rateDivisor(written);
+        // Named params (a mapping) are already in the new block's form.
+        if (rule.args && !isMap(keys.paramsNode)) args = rule.args(written);
+      } catch (e) {
+        ruleOk = false;
+        c.error(
+          "legacy-params",
+          keys.paramsPos,
+          `block '${name}' (${keys.written} → ${def.type}): cannot convert positional Params [${(written ?? []).join(", ")}]: ${errorMessage(e)}`,
+          {
+            block: name,
+            ...(e instanceof LegacyParamsError && e.param ? { param: e.param } : {}),
+          },
+        );
+      }
+    }
+    const params = ruleOk
+      ? readParams(c, {
+          block: name,
+          def,
+          doc,
+          node: keys.paramsNode,
+          pos: keys.paramsPos,
+          args,
+        })
+      : undefined;
+
+    // One warning per block: what an old name became, or what positional Params became.
+    const converted =
+      params?.converted !== undefined && !isEmptyObject(params.converted)
+        ? `Params ${paramsText(params.converted)}`
+        : undefined;
+    let mapping: { message: string } | undefined;
     if (keys.renamed && keys.written !== undefined) {
-      c.warn(
+      mapping = c.warn(
         "type-alias",
         keys.typePos,
-        `block '${name}': '${keys.written}' is the old name of ${def.type}; loading it as ${def.type}`,
+        mappingMessage(name, keys.written, def, rule, converted),
         { block: name },
       );
-    }
-    const params = readParams(c, {
-      block: name,
-      def,
-      doc,
-      node: keys.paramsNode,
-      pos: keys.paramsPos,
-      args,
-    });
-    if (params.converted !== undefined) {
+    } else if (params?.converted !== undefined) {
       convertedWarning(c, name, def.type, keys.paramsPos, params.converted);
     }
 
-    if (c.errors > errorsBefore || !params.ok) continue;
+    if (c.errors > errorsBefore || !params?.ok) continue;
     const spec: BlockSpec = {
       name,
       type: def.type,
@@ -133,9 +179,20 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
     };
     blocks.push(spec);
     byName.set(name, spec);
+    if (divisor !== undefined && mapping) {
+      pendingRates.push({
+        spec,
+        divisor,
+        at: keys.paramsPos,
+        warning: mapping,
+        withParams: converted !== undefined,
+      });
+    }
   }
+  ignoredKeysWarning(c, ignoredKeys);
+  resolvePendingRates(c, pendingRates, byName);
 
-  // Stage 4: wiring.
+  // Stage 5: wiring.
   const allNames = (root as YAMLMap).items
     .map((p) => scalarString(p.key))
     .filter((s): s is string => !!s);
@@ -151,4 +208,8 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
     ok,
     doc,
   };
+}
+
+function isEmptyObject(v: unknown): boolean {
+  return typeof v === "object" && v !== null && !Array.isArray(v) && Object.keys(v).length === 0;
 }
