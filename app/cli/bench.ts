@@ -1034,7 +1034,7 @@ export async function runBench(argv: string[]): Promise<number> {
   return results.every((r) => r.ok) ? 0 : 1;
 }
 
-function markdown(
+export function markdown(
   json: {
     generatedAt: string;
     suiteSeconds: number;
