@@ -1,5 +1,7 @@
 import { describe, expect, test } from "vitest";
 import {
+  createCatalog,
+  loadPipeline,
   matrixShape,
   vectorShape,
   type RosBridge,
@@ -324,5 +326,43 @@ describe("ROS block", () => {
       JointNames: ["a", "b", "c"],
     });
     expect(h.ports[0]!.shape).toEqual(vectorShape(3));
+  });
+
+  test("MOSAIC's positional form [host, publish|subscribe, topic, type, channels]", () => {
+    const catalog = createCatalog([Ros]);
+    const r = loadPipeline(
+      `P: { Type: ROS, Inputs: [ S ], Params: [ "localhost", "publish", "example_topic1", "std_msgs/Float64MultiArray", 10 ] }
+S: { Type: ROS, Inputs: [], Params: [ "10.0.0.2", "Subscribe", "example_topic3", "std_msgs/Float64MultiArray", 4 ] }
+`,
+      "p.yaml",
+      catalog,
+    );
+    expect(r.diagnostics.filter((d) => d.severity === "error")).toEqual([]);
+    expect(r.spec!.blocks.map((b) => b.params)).toEqual([
+      expect.objectContaining({
+        Url: "ws://localhost:9090",
+        Direction: "publish",
+        Topic: "/example_topic1",
+        MessageType: "std_msgs/Float64MultiArray",
+      }),
+      expect.objectContaining({
+        Url: "ws://10.0.0.2:9090",
+        Direction: "subscribe",
+        Topic: "/example_topic3",
+        Channels: 4,
+      }),
+    ]);
+    expect(r.spec!.blocks[0]!.params).not.toHaveProperty("Channels");
+    const bad = loadPipeline(
+      `S: { Type: ROS, Inputs: [], Params: [ localhost, listen, t, std_msgs/Float64MultiArray, 4 ] }
+T: { Type: ROS, Inputs: [], Params: [ localhost, subscribe, t, std_msgs/Float64MultiArray ] }
+`,
+      "p.yaml",
+      catalog,
+    );
+    expect(bad.diagnostics.filter((d) => d.severity === "error").map((d) => d.message)).toEqual([
+      expect.stringMatching(/'listen' is neither publish nor subscribe/),
+      expect.stringMatching(/a subscriber needs the number of channels/),
+    ]);
   });
 });

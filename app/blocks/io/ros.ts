@@ -3,6 +3,8 @@ import {
   BlockConfigError,
   defineBlock,
   errorMessage,
+  legacyInteger,
+  LegacyParamsError,
   vectorShape,
   type OutputPort,
   type RosBridge,
@@ -177,8 +179,51 @@ export const Ros = defineBlock({
     "counts down to the next attempt: `ReconnectSeconds`, doubling after each failure up to " +
     "`ReconnectMaxSeconds`; events to publish meanwhile are dropped and counted, never queued " +
     "(stale commands must not reach a robot late). Needs the desktop app or `mosaic run` (the " +
-    "browser build has no rosbridge connection: the status says so).",
+    "browser build has no rosbridge connection: the status says so). MOSAIC's positional form " +
+    "`[host, publish|subscribe, topic, messageType, channels]` loads as Url ws://host:9090 " +
+    "(rosbridge's default port, as MOSAIC connected), Direction, /topic, MessageType and, for a " +
+    "subscriber, Channels. MOSAIC's subscriber reshaped a message of several samples " +
+    "channel-major; here a message is one event of Channels values, others are malformed.",
   params,
+  legacyParams(args) {
+    if (args.length < 4 || args.length > 5) {
+      throw new LegacyParamsError(
+        `expected [host, publish|subscribe, topic, messageType, channels] (MOSAIC's ROS), got ${args.length} argument${args.length === 1 ? "" : "s"}`,
+      );
+    }
+    const host = args[0]!.trim();
+    if (host === "") throw new LegacyParamsError("the host (first argument) is empty", "Url");
+    const direction = args[1]!.trim().toLowerCase();
+    if (direction !== "publish" && direction !== "subscribe") {
+      throw new LegacyParamsError(
+        `the second argument '${args[1]!.trim()}' is neither publish nor subscribe`,
+        "Direction",
+      );
+    }
+    const topic = args[2]!.trim();
+    const out: Record<string, unknown> = {
+      // MOSAIC connected to rosbridge's default port and put a '/' before the topic.
+      Url: `ws://${host.includes(":") && !host.startsWith("[") ? `[${host}]` : host}:9090`,
+      Direction: direction,
+      Topic: topic.startsWith("/") ? topic : `/${topic}`,
+      MessageType: args[3]!.trim().replace(/^\//, ""),
+    };
+    // A publisher's width is its input's (MOSAIC read the number but did not use it).
+    if (direction === "subscribe") {
+      if (args[4] === undefined) {
+        throw new LegacyParamsError(
+          "a subscriber needs the number of channels as fifth argument",
+          "Channels",
+        );
+      }
+      out.Channels = legacyInteger(args[4], "the number of channels", "Channels");
+    }
+    return out;
+  },
+  legacyForm:
+    "[host, publish|subscribe, topic, messageType, channels], e.g. [localhost, subscribe, " +
+    "example_topic1, std_msgs/Float64MultiArray, 10] (rosbridge at ws://host:9090, the topic " +
+    "under /; a publisher's channels are its input's)",
   inputs: { min: 0, max: 1, labels: ["to publish"] },
   outputs: (p: Params) => (p.Direction === "subscribe" ? ["out"] : []),
   eventLoop: true,

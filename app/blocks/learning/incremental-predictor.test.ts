@@ -276,6 +276,13 @@ describe("IncrementalPredictor", () => {
       Lambda: 0.5,
       Intercept: false,
     });
+    // The older files' [d, M], without a machine (their blocks are named incr_RFF).
+    expect(convertLegacy(yaml("[8,12]"), "P")).toMatchObject({
+      Model: "rff",
+      Inputs: 8,
+      Outputs: 12,
+      Features: 300,
+    });
   });
 
   test("in a pipeline: learns from a plain target stream that arrives before the features", async () => {

@@ -78,11 +78,22 @@ export const IncrementalPredictor = defineBlock({
         "Model",
       );
     }
+    // The original's older files give only [d, M] (no machine; their blocks are named incr_RFF):
+    // IncrementalRFF with its defaults.
+    if (/^\s*[0-9]+\s*$/.test(args[0]!)) {
+      if (args.length !== 2) {
+        throw new LegacyParamsError(
+          `expected [machine, inputs, outputs, …] or the older [inputs, outputs], got [${args.join(", ")}]`,
+          "Model",
+        );
+      }
+      return legacyMachine("IncrementalRFF", args, [], MACHINES);
+    }
     return legacyMachine(args[0]!.trim(), args.slice(1, 3), args.slice(3), MACHINES);
   },
   legacyForm:
     "[IncrementalRidgeRegression, d, M, λ?] or [IncrementalRFF, d, M, λ?, σ?, D?] (MOSAIC's " +
-    "machine, input and output sizes, hyper-parameters)",
+    "machine, input and output sizes, hyper-parameters); the older [d, M] loads as IncrementalRFF",
   inputs: { min: 1, max: 2, labels: ["features", "target"] },
   outputs: ["prediction", "fit"],
   views: ["scope", "spider", "label"],
