@@ -27,6 +27,9 @@ import { VectorialFunction } from "./flow/vectorial-function";
 import { Ros } from "./io/ros";
 import { Myo } from "./io/myo";
 import { BlenderArm } from "./io/blender-arm";
+import { HannesGUI } from "./io/hannes-gui";
+import { HannesHand } from "./io/hannes-hand";
+import { HannesReceiver } from "./io/hannes-receiver";
 import { Python } from "./io/python";
 import { SerialPort } from "./io/serial-port";
 import { UdpReceiver } from "./io/udp-receiver";
@@ -107,6 +110,9 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   Myo,
   Ros,
   BlenderArm,
+  HannesHand,
+  HannesGUI,
+  HannesReceiver,
   // Recording
   Logger,
   // Testing

@@ -432,6 +432,22 @@ const SETUPS: Record<string, Setup | Setup[]> = {
     { params: { Port: 9 }, inputs: [vec(12)], io: recordingUdp },
     { params: { Port: 9, Input: "command" }, inputs: [vec(9)] },
   ],
+  HannesGUI: [
+    {
+      params: { Port: 9 },
+      inputs: [vec(11), vec(8, 200), vec(8, 25)],
+      pattern: [0, 1, 1, 2, 0, 1],
+      io: recordingUdp,
+    },
+    { params: { Port: 9, Input: "prediction" }, inputs: [vec(13)], io: recordingUdp },
+  ],
+  // Without a serial bridge: the references still go out (the handshake is in hannes.test.ts).
+  HannesHand: { params: { Port: "/dev/ttyACM0" }, inputs: [vec(11)] },
+  // Fed by its socket (hannes.test.ts): paced, it repeats zeros here.
+  HannesReceiver: [
+    { params: { Port: 9 }, inputs: [timer(100)] },
+    { params: { Port: 9, Channels: 8 }, inputs: [] },
+  ],
   // A source fed by its socket: nothing to feed here (tests/integration/udp.test.ts runs it).
   UdpReceiver: { params: { Port: 9, Channels: 3 }, inputs: [] },
   SerialPort: [
