@@ -11,75 +11,43 @@
  */
 import { readFileSync, writeFileSync } from "node:fs";
 import { describe, expect, test } from "vitest";
-import { markdown } from "./bench";
-import {
-  batchingMarkdown,
-  learnMarkdown,
-  pipelineMarkdown,
-  replayMarkdown,
-  targets,
-  type BatchingResult,
-  type LearnResult,
-  type PipelineResult,
-  type ReplayResult,
-  type TargetRow,
-  type UdpResult,
-  type WorkloadResult,
-} from "./bench-report";
-import { udpLatencyLine } from "./bench-udp";
-
-type Doc = Parameters<typeof markdown>[0] & {
-  schema: number;
-  machine: { clkTck: number };
-  targets: TargetRow[];
-  workloads: WorkloadResult[];
-};
+import { findings, latestMarkdown, notMeasured, type BenchDocument } from "./bench-results";
+import { workloadMarkdown } from "./bench-report";
+import { targets } from "./bench-targets";
+import type {
+  BatchingResult,
+  LearnResult,
+  PipelineResult,
+  ReplayResult,
+  UdpResult,
+  WorkloadResult,
+} from "./bench-types";
 
 const here = (name: string): URL => new URL(name, import.meta.url);
-const fixture = (): Doc => JSON.parse(readFileSync(here("bench-fixture.json"), "utf8")) as Doc;
+const fixture = (): BenchDocument =>
+  JSON.parse(readFileSync(here("bench-fixture.json"), "utf8")) as BenchDocument;
 
-/** What `mosaic bench` derives from the targets and results for latest.json (as runBench does). */
-function document(d: Doc, results: WorkloadResult[]): Doc {
+/** What `mosaic bench` derives from the results for latest.json. */
+function document(d: BenchDocument, results: WorkloadResult[]): BenchDocument {
   const rows = targets(results);
-  const lingering = results.filter((r) => r.killedAfterSummary);
   return {
     ...d,
     targets: rows,
-    notMeasured: rows
-      .filter((r) => r.pass === null && r.value === null)
-      .map((r) => ({ id: r.id, workload: r.workload, reason: r.note })),
-    findings: lingering.length
-      ? [
-          `${lingering.length} of ${results.length} \`mosaic run\` processes were still alive 1 s after ` +
-            "printing their summary and were terminated by the bench (SIGTERM). Nothing is lost (the " +
-            "summary is printed after the pipeline stopped and its logs were closed), but a finished " +
-            "run should exit at once.",
-        ]
-      : [],
+    notMeasured: notMeasured(rows),
+    findings: findings(results),
     workloads: results,
   };
 }
 
 /** The tables `mosaic bench` prints on stdout as each workload finishes. */
 function printed(results: WorkloadResult[]): string[] {
-  const lines: string[] = [];
-  for (const r of results) {
-    if (r.kind === "pipeline") lines.push(...pipelineMarkdown(r, "##"));
-    else if (r.kind === "batching") lines.push(...batchingMarkdown(r, "##"));
-    else if (r.kind === "learn") lines.push(...learnMarkdown(r, "##"));
-    else if (r.kind === "replay") lines.push(...replayMarkdown([r], "##"));
-    else {
-      lines.push(`## ${r.title}`, "");
-      lines.push(r.ok ? udpLatencyLine(r) : `**Failed:** ${r.error ?? "unknown error"}`, "");
-    }
-  }
-  return lines;
+  return results.flatMap(workloadMarkdown);
 }
 
-function render(d: Doc): string {
+function render(d: BenchDocument): string {
   return (
     [
-      markdown(d, d.targets, d.workloads),
+      latestMarkdown(d),
       "<!-- stdout -->",
       ...printed(d.workloads),
       "<!-- targets -->",
@@ -89,7 +57,7 @@ function render(d: Doc): string {
 }
 
 function byId<K extends WorkloadResult["kind"]>(
-  d: Doc,
+  d: BenchDocument,
   kind: K,
   id: string,
 ): Extract<WorkloadResult, { kind: K }> {
@@ -99,7 +67,7 @@ function byId<K extends WorkloadResult["kind"]>(
 }
 
 /** Every workload, with failures and the rarer lines (a full run on a bad day). */
-function everything(d: Doc): Doc {
+function everything(d: BenchDocument): BenchDocument {
   const myo = byId(d, "pipeline", "myo");
   const loaded = byId(d, "pipeline", "delsys-loaded");
   const delsys: PipelineResult = {
@@ -194,7 +162,7 @@ function everything(d: Doc): Doc {
 }
 
 /** Nothing measured: failures only, every target "not measured". */
-function nothing(d: Doc): Doc {
+function nothing(d: BenchDocument): BenchDocument {
   const learn: LearnResult = { ...byId(d, "learn", "learn"), ok: false, error: "no wasm" };
   const udp: UdpResult = { ...byId(d, "udp", "udp"), ok: false, error: "EADDRINUSE" };
   const batching: BatchingResult = {
@@ -215,9 +183,7 @@ function nothing(d: Doc): Doc {
 describe("bench report output (golden)", () => {
   test("latest.md of the fixture run is rendered byte for byte", () => {
     const d = fixture();
-    expect(markdown(d, d.targets, d.workloads)).toBe(
-      readFileSync(here("bench-fixture.md.txt"), "utf8"),
-    );
+    expect(latestMarkdown(d)).toBe(readFileSync(here("bench-fixture.md.txt"), "utf8"));
   });
 
   test("the targets of the fixture run are those it wrote", () => {

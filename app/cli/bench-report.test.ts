@@ -1,17 +1,15 @@
 import { describe, expect, test } from "vitest";
-import { selects } from "./bench";
-import {
-  batchingMarkdown,
-  learnMarkdown,
-  pipelineMarkdown,
-  targets,
-  udpRxLine,
-  type BatchingResult,
-  type BlockRow,
-  type LearnResult,
-  type PipelineResult,
-  type UdpRxFigures,
-} from "./bench-report";
+import { batchingMarkdown, learnMarkdown } from "./bench-report";
+import { pipelineMarkdown, udpRxLine } from "./bench-report-pipeline";
+import { targets } from "./bench-targets";
+import type {
+  BatchingResult,
+  BlockRow,
+  LearnResult,
+  PipelineResult,
+  UdpRxFigures,
+} from "./bench-types";
+import { selects } from "./bench-workloads";
 
 const row = (name: string, type: string, rate: number): BlockRow => ({
   name,

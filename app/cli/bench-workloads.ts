@@ -1,0 +1,182 @@
+/**
+ * `mosaic bench`: the workloads of the suite (DESIGN.md §6) and how `--only` selects them.
+ */
+
+export interface PipelineDef {
+  kind: "pipeline";
+  id: string;
+  title: string;
+  file: string;
+  paper?: "myo" | "delsys";
+  extra?: string[];
+  /** The timer workloads run for half the steady-state duration. */
+  short?: boolean;
+  /** The acquisition block (the simulated device). */
+  acquisition?: string;
+  /** The rate the Sender sends events at (Hz): the bench receives on the Sender's port (read
+   * from the file) and checks the rate and the gaps against this. */
+  udpRateHz?: number;
+  /** Run while a neighbour process burns one core. */
+  neighbour?: boolean;
+}
+export interface BatchingDef {
+  kind: "batching";
+  id: string;
+  title: string;
+  /** Ids of the pipeline workloads swept. */
+  pipelines: string[];
+  intervalsMs: number[];
+}
+export interface ReplayDef {
+  kind: "replay";
+  id: string;
+  title: string;
+  channels: number;
+  rate: number;
+  recordingSeconds: number;
+}
+export interface LearnDef {
+  kind: "learn";
+  id: string;
+  title: string;
+  dims: number[];
+  outputs: number;
+}
+export interface UdpDef {
+  kind: "udp";
+  id: string;
+  title: string;
+  timerHz: number;
+}
+export type WorkloadDef = PipelineDef | ReplayDef | LearnDef | UdpDef | BatchingDef;
+
+/** 1926 Hz / 77: the Delsys pipelines' 25 Hz branch (MOSAIC's 25.013 Hz). */
+const DELSYS_25 = 1926 / 77;
+/** 2048 Hz / 82: the high-density pipeline's 25 Hz branch. */
+const HDEMG_25 = 2048 / 82;
+
+export const WORKLOADS: WorkloadDef[] = [
+  {
+    kind: "pipeline",
+    id: "myo",
+    title: "(a) Myo pipeline — 8 ch @ 200 Hz",
+    file: "myo.yaml",
+    paper: "myo",
+    acquisition: "Myo",
+    udpRateHz: 25,
+  },
+  {
+    kind: "pipeline",
+    id: "delsys",
+    title: "(b) Delsys pipeline — 32 ch @ 1926 Hz",
+    file: "delsys.yaml",
+    paper: "delsys",
+    acquisition: "Delsys",
+    udpRateHz: DELSYS_25,
+  },
+  {
+    kind: "pipeline",
+    id: "delsys-loaded",
+    title: "(b) Delsys pipeline — 32 ch @ 1926 Hz, while a neighbour process burns one core",
+    file: "delsys.yaml",
+    paper: "delsys",
+    acquisition: "Delsys",
+    udpRateHz: DELSYS_25,
+    neighbour: true,
+  },
+  {
+    kind: "pipeline",
+    id: "hdemg",
+    title: "(c) High-density EMG — 256 ch @ 2048 Hz",
+    file: "hdemg.yaml",
+    acquisition: "HDEMG",
+    udpRateHz: HDEMG_25,
+  },
+  {
+    kind: "pipeline",
+    id: "hdemg-features",
+    title: "(d) High-density EMG features — 256 ch @ 2048 Hz, 200 ms windows every 25 ms",
+    file: "hdemg-features.yaml",
+    acquisition: "HDEMG",
+    udpRateHz: 2048 / 51,
+  },
+  {
+    kind: "pipeline",
+    id: "python-cnn",
+    title:
+      "(e) Deep model in the Python sidecar — 32 ch @ 1926 Hz, 200-sample windows every 77 (25 Hz), ONNX 1-D CNN, control, UDP",
+    file: "python-cnn.yaml",
+    acquisition: "Delsys",
+    udpRateHz: DELSYS_25,
+  },
+  {
+    kind: "pipeline",
+    id: "timer",
+    title: "Timer at 2 kHz, default mode, batching interval 0",
+    file: "timer-2khz.yaml",
+    extra: ["--batching-ms", "0"],
+    short: true,
+  },
+  {
+    kind: "pipeline",
+    id: "timer-precision",
+    title: "Timer at 2 kHz, --precision, batching interval 0",
+    file: "timer-2khz.yaml",
+    extra: ["--batching-ms", "0", "--precision"],
+    short: true,
+  },
+  {
+    kind: "replay",
+    id: "replay-32",
+    title: "Replay 32 ch @ 1926 Hz",
+    channels: 32,
+    rate: 1926,
+    recordingSeconds: 10,
+  },
+  {
+    kind: "replay",
+    id: "replay-256",
+    title: "Replay 256 ch @ 2048 Hz",
+    channels: 256,
+    rate: 2048,
+    recordingSeconds: 4,
+  },
+  {
+    kind: "learn",
+    id: "learn",
+    title:
+      "Learning kernels (WASM micro-benchmarks): ridge and RFF, incremental update and prediction",
+    dims: [8, 64, 256],
+    outputs: 12,
+  },
+  {
+    kind: "udp",
+    id: "udp",
+    title:
+      "UDP latency — datagram in → UdpReceiver → Function → UdpSender → datagram out (batching interval 0)",
+    timerHz: 200,
+  },
+  {
+    kind: "batching",
+    id: "batching",
+    title:
+      "Batching sweep — the Delsys and Myo pipelines at --batching-ms 0, 1, 2, 5, 10: CPU, engine wake-ups, delivery delay",
+    pipelines: ["delsys", "myo"],
+    intervalsMs: [0, 1, 2, 5, 10],
+  },
+];
+
+/** The pipeline workload `id`. */
+export function pipelineDef(id: string): PipelineDef | undefined {
+  return WORKLOADS.find((w): w is PipelineDef => w.kind === "pipeline" && w.id === id);
+}
+
+/**
+ * Whether `--only` name `n` selects workload `id`: a workload's own id selects it alone; `NAME*`,
+ * or a name that is no workload's id (`replay`), selects the group `NAME` and `NAME-…`.
+ */
+export function selects(n: string, id: string): boolean {
+  const group = n.endsWith("*") ? n.slice(0, -1) : WORKLOADS.some((w) => w.id === n) ? null : n;
+  if (group === null) return id === n;
+  return id === group || id.startsWith(group + "-");
+}
