@@ -128,54 +128,16 @@ export async function measureUdpLatency(opts: UdpLatencyOptions = {}): Promise<U
   const inPort = await freePort();
   const dir = mkdtempSync(join(tmpdir(), "mosaic-bench-udp-"));
   const file = join(dir, "udp-latency.yaml");
-  writeFileSync(
-    file,
-    [
-      `Rx: { Type: UdpReceiver, Params: { Port: ${inPort}, Channels: ${channels} } }`,
-      "Abs: { Type: Function, Inputs: [Rx], Params: { Operation: abs } }",
-      `Tx: { Type: UdpSender, Inputs: [Abs], Params: { Port: ${outPort} } }`,
-      ...(timerHz > 0
-        ? [
-            `Timer: { Type: ScheduledTimer, DesiredRate: ${timerHz} }`,
-            "Emg: { Type: EmgSimulator, Inputs: [Timer], Params: { Channels: 8 } }",
-            "Rect: { Type: Function, Inputs: [Emg], Params: { Operation: abs } }",
-            "Out: { Type: Sink, Inputs: [Rect] }",
-          ]
-        : []),
-      "",
-    ].join("\n"),
-  );
+  writeFileSync(file, latencyPipeline(inPort, outPort, channels, timerHz));
 
-  const total = samples + Math.ceil(warmup * rate);
-  const sentAt = new Float64Array(total).fill(NaN);
-  const latency = new Float64Array(total).fill(NaN);
-  const inPart = new Float64Array(total).fill(NaN);
-  let received = 0;
-  let fatal = "";
-  probe.on("message", (msg) => {
-    const now = performance.now();
-    if (msg.length < HEADER + 8) return;
-    const seq = msg.readDoubleLE(HEADER);
-    if (!(seq >= 0 && seq < total) || !Number.isInteger(seq)) return;
-    if (Number.isNaN(latency[seq]!)) {
-      latency[seq] = now - sentAt[seq]!;
-      // Tx writes the event's timestamp: the time Rx got the datagram.
-      inPart[seq] = msg.readDoubleLE(4) * 1000 - (performance.timeOrigin + sentAt[seq]!);
-      received++;
-    }
-  });
-
-  const loaded = await Host.load(
-    file,
-    {
-      mode: "realtime",
-      precision: opts.precision ?? false,
-      ...(opts.batchingMs !== undefined ? { batchingS: opts.batchingMs / 1000 } : {}),
-      ...(opts.workerPath ? { workerPath: opts.workerPath } : {}),
-      ...(opts.wasmPath ? { wasmPath: opts.wasmPath } : {}),
-    },
-    { fatal: (m) => (fatal = m) },
-  );
+  const trips = new RoundTrips(samples + Math.ceil(warmup * rate));
+  probe.on("message", (msg) => trips.onReply(msg, performance.now()));
+  const send = (seq: number): void => {
+    trips.sentAt[seq] = performance.now();
+    probe.send(datagram(seq, channels, Date.now() / 1000), inPort, "127.0.0.1");
+  };
+  const failure = { fatal: "" };
+  const loaded = await Host.load(file, hostOptions(opts), { fatal: (m) => (failure.fatal = m) });
   if (!loaded.host) {
     probe.close();
     rmSync(dir, { recursive: true, force: true });
@@ -186,39 +148,141 @@ export async function measureUdpLatency(opts: UdpLatencyOptions = {}): Promise<U
   const host = loaded.host;
   try {
     host.start();
-    // Wait until the receiver listens: a datagram makes the round trip (probes use seq 0).
-    const readyBy = performance.now() + 10_000;
-    while (received === 0) {
-      if (fatal) throw new Error(fatal);
-      if (performance.now() > readyBy) throw new Error("the pipeline did not answer within 10 s");
-      sentAt[0] = performance.now();
-      probe.send(datagram(0, channels, Date.now() / 1000), inPort, "127.0.0.1");
-      await sleep(20);
-    }
+    await waitForAnswer(trips, send, failure);
     await sleep(50);
-    latency.fill(NaN);
-    inPart.fill(NaN);
-    received = 0;
-    // Steady traffic, paced by timers (no spinning: the machine may have two cores only); each
-    // datagram is timed from when it was actually sent, so pacing jitter does not count.
-    const period = 1000 / rate;
-    const t0 = performance.now();
-    let next = 0;
-    while (next < total) {
-      const due = t0 + next * period;
-      const now = performance.now();
-      if (now < due) await sleep(Math.max(0, Math.round(due - now)));
-      sentAt[next] = performance.now();
-      probe.send(datagram(next, channels, Date.now() / 1000), inPort, "127.0.0.1");
-      next++;
-      if (fatal) throw new Error(fatal);
-    }
+    trips.reset();
+    await steadyTraffic(trips.total, rate, send, failure);
     await sleep(200);
   } finally {
     await host.stop();
     probe.close();
     rmSync(dir, { recursive: true, force: true });
   }
+  return latencyResult(trips, {
+    samples,
+    rate,
+    channels,
+    timerHz,
+    batchingMs: opts.batchingMs ?? NaN,
+  });
+}
+
+/** Rx → Abs → Tx, and the timer branch that gives the worker a normal pipeline's deadlines. */
+function latencyPipeline(
+  inPort: number,
+  outPort: number,
+  channels: number,
+  timerHz: number,
+): string {
+  return [
+    `Rx: { Type: UdpReceiver, Params: { Port: ${inPort}, Channels: ${channels} } }`,
+    "Abs: { Type: Function, Inputs: [Rx], Params: { Operation: abs } }",
+    `Tx: { Type: UdpSender, Inputs: [Abs], Params: { Port: ${outPort} } }`,
+    ...(timerHz > 0
+      ? [
+          `Timer: { Type: ScheduledTimer, DesiredRate: ${timerHz} }`,
+          "Emg: { Type: EmgSimulator, Inputs: [Timer], Params: { Channels: 8 } }",
+          "Rect: { Type: Function, Inputs: [Emg], Params: { Operation: abs } }",
+          "Out: { Type: Sink, Inputs: [Rect] }",
+        ]
+      : []),
+    "",
+  ].join("\n");
+}
+
+function hostOptions(opts: UdpLatencyOptions): Parameters<typeof Host.load>[1] {
+  return {
+    mode: "realtime",
+    precision: opts.precision ?? false,
+    ...(opts.batchingMs !== undefined ? { batchingS: opts.batchingMs / 1000 } : {}),
+    ...(opts.workerPath ? { workerPath: opts.workerPath } : {}),
+    ...(opts.wasmPath ? { wasmPath: opts.wasmPath } : {}),
+  };
+}
+
+/** The round trips of one measurement, by sequence number (NaN: not sent, or no reply yet). */
+class RoundTrips {
+  readonly total: number;
+  readonly sentAt: Float64Array;
+  /** Sending → the sender's datagram back, ms. */
+  readonly latency: Float64Array;
+  /** Sending → the receiver's callback, ms. */
+  readonly inPart: Float64Array;
+  received = 0;
+
+  constructor(total: number) {
+    this.total = total;
+    this.sentAt = new Float64Array(total).fill(NaN);
+    this.latency = new Float64Array(total).fill(NaN);
+    this.inPart = new Float64Array(total).fill(NaN);
+  }
+
+  /** The sender's datagram `msg` arrived at `now`: its sequence number is value 0. */
+  onReply(msg: Buffer, now: number): void {
+    if (msg.length < HEADER + 8) return;
+    const seq = msg.readDoubleLE(HEADER);
+    if (!(seq >= 0 && seq < this.total) || !Number.isInteger(seq)) return;
+    if (Number.isNaN(this.latency[seq]!)) {
+      this.latency[seq] = now - this.sentAt[seq]!;
+      // Tx writes the event's timestamp: the time Rx got the datagram.
+      this.inPart[seq] = msg.readDoubleLE(4) * 1000 - (performance.timeOrigin + this.sentAt[seq]!);
+      this.received++;
+    }
+  }
+
+  /** Forget the probes before the timed traffic. */
+  reset(): void {
+    this.latency.fill(NaN);
+    this.inPart.fill(NaN);
+    this.received = 0;
+  }
+}
+
+/** Wait until the receiver listens: a datagram makes the round trip (probes use seq 0). */
+async function waitForAnswer(
+  trips: RoundTrips,
+  send: (seq: number) => void,
+  failure: { fatal: string },
+): Promise<void> {
+  const readyBy = performance.now() + 10_000;
+  while (trips.received === 0) {
+    if (failure.fatal) throw new Error(failure.fatal);
+    if (performance.now() > readyBy) throw new Error("the pipeline did not answer within 10 s");
+    send(0);
+    await sleep(20);
+  }
+}
+
+/**
+ * Steady traffic, paced by timers (no spinning: the machine may have two cores only); each
+ * datagram is timed from when it was actually sent, so pacing jitter does not count.
+ */
+async function steadyTraffic(
+  total: number,
+  rate: number,
+  send: (seq: number) => void,
+  failure: { fatal: string },
+): Promise<void> {
+  const period = 1000 / rate;
+  const t0 = performance.now();
+  let next = 0;
+  while (next < total) {
+    const due = t0 + next * period;
+    const now = performance.now();
+    if (now < due) await sleep(Math.max(0, Math.round(due - now)));
+    send(next);
+    next++;
+    if (failure.fatal) throw new Error(failure.fatal);
+  }
+}
+
+/** The quantiles of the last `samples` round trips (the warm-up's left out). */
+function latencyResult(
+  trips: RoundTrips,
+  o: Pick<UdpLatencyResult, "samples" | "rate" | "channels" | "timerHz" | "batchingMs">,
+): UdpLatencyResult {
+  const { latency, inPart, total } = trips;
+  const { samples, rate, channels, timerHz, batchingMs } = o;
   const first = total - samples;
   const timed = latency.subarray(first).filter((x) => !Number.isNaN(x));
   timed.sort();
@@ -242,7 +306,7 @@ export async function measureUdpLatency(opts: UdpLatencyOptions = {}): Promise<U
     rate,
     channels,
     timerHz,
-    batchingMs: opts.batchingMs ?? NaN,
+    batchingMs,
     p50Ms: quantileMs(timed, 0.5),
     p90Ms: quantileMs(timed, 0.9),
     p99Ms: quantileMs(timed, 0.99),
