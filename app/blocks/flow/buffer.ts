@@ -2,7 +2,25 @@ import { z } from "zod";
 import { BlockConfigError, defineBlock, errorMessage, vectorShape } from "../../engine";
 import { indexArg, vectorArg } from "../shared/args";
 import { signalInput, vectorInput } from "../shared/inputs";
+import { publish } from "../shared/named";
 import { formatCount, formatVector, plural, TextThrottle } from "../shared/text";
+
+/**
+ * What a Buffer offers by its name (shared/named.ts, kind "Buffer") to the blocks that MOSAIC let
+ * read it by name (BatchPredictor, PythonNetLearning): its rows, read on request.
+ */
+export interface BufferRows {
+  /** T, values per target. */
+  readonly targetWidth: number;
+  /** D, values per data row. */
+  readonly dataWidth: number;
+  /** Rows stored now. */
+  rows(): number;
+  /** The stored rows [target…, data…], rows × (T + D) values; read before the next event. */
+  values(): Float64Array;
+  /** Calls `fn` whenever a cluster with rows closes (recording stops or changes target). */
+  onClusterClosed(fn: () => void): () => void;
+}
 
 /** Most values the store may hold (1 GiB of doubles). */
 const MAX_VALUES = 2 ** 27;
@@ -44,7 +62,9 @@ export const BufferBlock = defineBlock({
     "`pairs` output (how a BatchPredictor is trained). With `Stream: true` rows are also sent on " +
     "`pairs` as they are recorded. Memory is bounded by `MaxRows`: when it is full, further rows " +
     "are dropped and counted, and the status says so until you save, emit or clear. Clusters " +
-    "that received no rows are not kept.",
+    "that received no rows are not kept. Blocks that MOSAIC let read a Buffer by its name " +
+    "(a BatchPredictor or PythonNetLearning written `[bufferName, …]`) read its rows when they " +
+    "build their model, on the same worker.",
   params: z.strictObject({
     Stream: z
       .boolean()
@@ -138,11 +158,24 @@ export const BufferBlock = defineBlock({
       times = t;
     };
 
+    const closedListeners = new Set<() => void>();
     /** Closes the current cluster (kept only if it received rows). */
     const close = (): void => {
-      if (current && current.rows > 0) clusters.push(current);
+      const closed = current !== null && current.rows > 0;
+      if (closed) clusters.push(current!);
       current = null;
+      if (closed) for (const fn of closedListeners) fn();
     };
+    const withdraw = publish(ctx, "Buffer", {
+      targetWidth: T,
+      dataWidth: D,
+      rows: () => rows,
+      values: () => values.subarray(0, rows * W),
+      onClusterClosed(fn: () => void) {
+        closedListeners.add(fn);
+        return () => closedListeners.delete(fn);
+      },
+    } satisfies BufferRows);
     const start = (target: ArrayLike<number>): void => {
       if (current && sameValues(current.target, target)) return;
       close();
@@ -281,6 +314,10 @@ export const BufferBlock = defineBlock({
       },
       setParam(name, value) {
         if (name === "Stream") stream = value as boolean;
+      },
+      dispose() {
+        withdraw();
+        closedListeners.clear();
       },
       actions: {
         start: {

@@ -2,12 +2,18 @@ import { readFileSync } from "node:fs";
 import { join } from "node:path";
 import { beforeAll, describe, expect, test } from "vitest";
 import { Frame, vectorShape } from "../../engine";
-import { BlockHarness } from "../../engine/testing";
+import { BlockHarness, noResources, runVirtualPipeline } from "../../engine/testing";
 import { convertLegacy, loadBlock, vectors } from "../../../tests/support/blocks";
 import { memoryResources, REPO_ROOT } from "../../../tests/support/fs-resources";
 import { initDspForTests } from "../../../tests/support/wasm";
+import { createCatalog, loadPipeline, Runtime, runVirtual, VirtualClock } from "../../engine";
 import { BufferBlock } from "../flow/buffer";
+import { SinGenerator } from "../sources/sin-generator";
+import { ScheduledTimer } from "../timing/scheduled-timer";
 import { BatchPredictor } from "./batch-predictor";
+import { Trigger } from "./trigger";
+
+const catalog = createCatalog([ScheduledTimer, SinGenerator, Trigger, BufferBlock, BatchPredictor]);
 
 beforeAll(() => initDspForTests());
 
@@ -199,9 +205,53 @@ describe("BatchPredictor", () => {
       ),
     ).rejects.toThrow(/rows must be \[target…, data…\] with the 4 data values of 'in0'/);
     await expect(batch({ Buffer: "cluster_storage" }, 8, null)).rejects.toThrow(
-      "MOSAIC's BatchPredictor read the Buffer 'cluster_storage' directly; here its rows arrive " +
-        "on a second input: write `Inputs: [in0, cluster_storage]`",
+      "reading the Buffer 'cluster_storage' by name needs Outputs (the width of its targets)",
     );
+  });
+
+  test("MOSAIC's one-input form reads the named Buffer's rows when a cluster ends, or on train", async () => {
+    // cfg4's wiring: the Buffer records [target, features] between Trigger events; the predictor's
+    // only input is the features.
+    const yaml = (autoTrain: string) => `
+T: { Type: ScheduledTimer, DesiredRate: 25 }
+F: { Type: SinGenerator, Inputs: [T], Params: { Components: 2, Frequency: 0.5 } }
+capture: { Type: Trigger, Params: { Labels: { rest: [0], up: [1] }, Schedule: { Seconds: 1, Pause: 0.5, Start: 0.2 } } }
+store: { Type: Buffer, Inputs: [capture, -F] }
+P: { Type: BatchPredictor, Inputs: [F], Params: { Buffer: store, Model: ridge, Outputs: 1, Lambda: 1e-6${autoTrain} } }
+`;
+    const live = async (y: string) => {
+      const loaded = loadPipeline(y, "p.yaml", catalog);
+      const clock = new VirtualClock(0);
+      const created = await Runtime.create({
+        spec: loaded.spec!,
+        catalog,
+        clock,
+        virtual: true,
+        resources: noResources,
+      });
+      expect(created.diagnostics).toEqual([]);
+      const rt = created.runtime!;
+      rt.start();
+      runVirtual(rt, clock, 4);
+      return rt;
+    };
+    const auto = await live(yaml(""));
+    // Fitted when each of the two clusters ended, the second time on all the rows.
+    expect(auto.invoke("P", "inspect")).toMatch(/fitted on 49 rows/);
+    auto.dispose();
+    const manual = await live(yaml(", AutoTrain: false"));
+    expect(manual.invoke("P", "inspect")).toMatch(/fitted on 0 rows/);
+    expect(manual.invoke("P", "train")).toMatch(/fitted ridge .* on 49 rows/);
+    manual.dispose();
+    const lone = await runVirtualPipeline(
+      "T: { Type: ScheduledTimer, DesiredRate: 25 }\n" +
+        "F: { Type: SinGenerator, Inputs: [T], Params: { Components: 2 } }\n" +
+        "P: { Type: BatchPredictor, Inputs: [F], Params: { Buffer: nope, Outputs: 1 } }\n",
+      { catalog, duration: 0.1 },
+    );
+    expect(lone.telemetry.events.map((e) => e.message)).toEqual([
+      expect.stringMatching(/Buffer 'nope' \(Params\): there is no Buffer 'nope' in this pipeline/),
+    ]);
   });
 
   test("MOSAIC's positional Params", () => {

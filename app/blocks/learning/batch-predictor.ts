@@ -9,7 +9,9 @@ import {
 } from "../../engine";
 import type { LearningModel, ResolvedLearningOptions } from "../../engine/dsp";
 import { requireDsp } from "../shared/dsp";
+import type { BufferRows } from "../flow/buffer";
 import { inputName, signalInput } from "../shared/inputs";
+import { lookup } from "../shared/named";
 import { formatCount, plural } from "../shared/text";
 import {
   createModel,
@@ -62,8 +64,9 @@ const params = z.strictObject({
     .min(1)
     .optional()
     .describe(
-      "MOSAIC's form named the Buffer in Params; here the Buffer's pairs output is the second " +
-        "input (this name is only checked against it)",
+      "MOSAIC's form: the Buffer whose rows train the model, read by name when the model is " +
+        "built (train action, or with AutoTrain whenever the Buffer closes a cluster); with a " +
+        "second input (the Buffer's pairs output), only checked against it",
     ),
 });
 
@@ -87,7 +90,9 @@ export const BatchPredictor = defineBlock({
     "params describe. Actions: `train` (fit on the rows kept), `clear` (drop the rows), `reset` " +
     "(forget the model), `save` and `load` (a file name, default File or <block>.model.json) and " +
     "`inspect`. MOSAIC's `[buffer, RR_RFF, 8, 12, λ, σ, D]` loads as the same model (γ = σ²/2, " +
-    "λ·2/D, no intercept); its Buffer must then be written as the second input.",
+    "λ·2/D, no intercept) with one input: as in MOSAIC it reads the named Buffer's rows when the " +
+    "model is built (the train action, MOSAIC's Build model; with AutoTrain also whenever the " +
+    "Buffer closes a cluster). The Buffer must run on the same worker.",
   params,
   legacyParams: (args) => {
     if (args.length < 2) {
@@ -122,12 +127,12 @@ export const BatchPredictor = defineBlock({
       );
     }
     const pairsIn = ctx.inputs.length > 1 ? signalInput(ctx, 1) : null;
-    if (!pairsIn && p.Buffer !== undefined) {
+    // MOSAIC's form: the Buffer named in Params is read when the model is built.
+    const named = !pairsIn && p.Buffer !== undefined ? p.Buffer : undefined;
+    if (named !== undefined && p.Outputs === undefined && p.File === undefined) {
       throw new BlockConfigError(
-        `MOSAIC's BatchPredictor read the Buffer '${p.Buffer}' directly; here its rows arrive on a ` +
-          `second input: write \`Inputs: [${feat.info.source}, ${p.Buffer}]\` (then the Buffer's ` +
-          "emit action trains the model)",
-        "Buffer",
+        `reading the Buffer '${named}' by name needs Outputs (the width of its targets)`,
+        "Outputs",
       );
     }
     if (pairsIn && p.Buffer !== undefined && pairsIn.info.block !== p.Buffer) {
@@ -200,7 +205,7 @@ export const BatchPredictor = defineBlock({
     }
     const M = m;
     const maxRows = p.MaxRows;
-    if (pairsIn && maxRows * W > MAX_VALUES) {
+    if ((pairsIn || named !== undefined) && maxRows * W > MAX_VALUES) {
       throw new BlockConfigError(
         `MaxRows ${formatCount(maxRows)} rows of ${W} values would take up to ` +
           `${((maxRows * W * 8) / 2 ** 30).toFixed(1)} GiB; at most ${formatCount(MAX_VALUES)} ` +
@@ -235,6 +240,10 @@ export const BatchPredictor = defineBlock({
         s =
           `${plural(rows, "row")} kept` + (fittedRows >= 0 ? "; fitted before on other rows" : "");
         s += p.AutoTrain ? "" : " (press train)";
+      } else if (named !== undefined && model.samplesSeen() === 0) {
+        s =
+          `untrained: reads the Buffer '${named}'` +
+          (p.AutoTrain ? " when a cluster ends" : " (press train)");
       } else if (model.samplesSeen() > 0) {
         model.r2(r2);
         s = `trained on ${plural(model.samplesSeen(), "row")}, ${formatR2(r2)}; no rows kept`;
@@ -273,6 +282,24 @@ export const BatchPredictor = defineBlock({
         (refused > 0 ? ` (${formatCount(refused)} refused)` : "") +
         `, in-sample ${formatR2(r2)}`
       );
+    };
+
+    /** Replaces the rows by the named Buffer's and fits; a sentence saying what happened. */
+    const fitFromBuffer = (t: number): string => {
+      const b = lookup<BufferRows>(ctx, named!, "Buffer");
+      if (typeof b === "string") throw new Error(`cannot read the Buffer: ${b}`);
+      if (b.targetWidth !== M || b.dataWidth !== d) {
+        throw new Error(
+          `the Buffer '${named}' stores targets of ${b.targetWidth} and data of ${b.dataWidth} ` +
+            `values; this model maps ${d} inputs to ${M} outputs`,
+        );
+      }
+      const n = Math.min(b.rows(), maxRows);
+      dropped = b.rows() - n;
+      grow(n);
+      values.set(b.values().subarray(0, n * W));
+      rows = n;
+      return fit(t);
     };
 
     let warnedFull = false;
@@ -334,7 +361,29 @@ export const BatchPredictor = defineBlock({
       },
     };
 
+    let unlisten: (() => void) | undefined;
     return {
+      start() {
+        if (named === undefined || unlisten) return;
+        const b = lookup<BufferRows>(ctx, named, "Buffer");
+        if (typeof b === "string") {
+          ctx.warn(`Buffer '${named}' (Params): ${b}; the model cannot be trained from it`);
+          return;
+        }
+        // AutoTrain: fit whenever the Buffer closes a cluster (in this block's turn, not the
+        // Buffer's); otherwise on the train action, MOSAIC's "Build model".
+        if (p.AutoTrain) {
+          unlisten = b.onClusterClosed(() =>
+            ctx.at(ctx.now(), (t) => {
+              try {
+                fitFromBuffer(t);
+              } catch (e) {
+                ctx.warn(errorMessage(e));
+              }
+            }),
+          );
+        }
+      },
       process(f, port) {
         if (f.n === 0) return;
         if (port === 1) onRows(f);
@@ -358,14 +407,18 @@ export const BatchPredictor = defineBlock({
       dispose() {
         if (disposed) return;
         disposed = true;
+        unlisten?.();
         model.dispose();
       },
       actions: {
         train: {
           label: "Train",
-          description: "Fit the model on every row kept",
+          description:
+            named !== undefined
+              ? `Fit the model on every row of the Buffer '${named}'`
+              : "Fit the model on every row kept",
           run() {
-            return fit(ctx.now());
+            return named !== undefined ? fitFromBuffer(ctx.now()) : fit(ctx.now());
           },
         },
         clear: {

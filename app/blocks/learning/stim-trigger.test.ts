@@ -67,25 +67,42 @@ store: { Type: Buffer, Inputs: [ trig, -shown ] }
     );
   });
 
-  test("the Stimulus's default output is refused with the fix", async () => {
-    const loaded = loadPipeline(
+  test("wired to the Stimulus's default output (MOSAIC's files): its capture phases, read by name", async () => {
+    const yaml = `
+timer: { Type: ScheduledTimer, DesiredRate: 10 }
+stim: { Type: Stimulus, Inputs: [ -timer ], Params: { Tasks: [ { Label: a, Target: [1, 0] }, { Label: b, Target: [0, 1] } ], Rest: 0.5, Rise: 0.2, Hold: 0.3, Capture: 1, Fall: 0.2, Autostart: true } }
+trig: { Type: StimTrigger, Inputs: [ stim ] }
+direct: { Type: StimTrigger, Inputs: [ stim.trigger ] }
+`;
+    const run = await runVirtualPipeline(yaml, { catalog, duration: 6, start: 100 });
+    const a = run.outputs.get("trig")!;
+    const b = run.outputs.get("direct")!;
+    expect(a.v).toEqual([
+      [1, 0],
+      [NaN, NaN],
+      [0, 1],
+      [NaN, NaN],
+    ]);
+    expect(a.t).toEqual(b.t);
+    const phase = loadPipeline(
       `timer: { Type: ScheduledTimer, DesiredRate: 10 }
 stim: { Type: Stimulus, Inputs: [ -timer ], Params: [ 3.0, 1;0, 0;1 ] }
-trig: { Type: StimTrigger, Inputs: [ stim ] }
+trig: { Type: StimTrigger, Inputs: [ stim.phase ] }
 `,
       "p.yaml",
       catalog,
     );
-    expect(loaded.spec).toBeDefined();
     const created = await Runtime.create({
-      spec: loaded.spec!,
+      spec: phase.spec!,
       catalog,
       clock: new VirtualClock(0),
       virtual: true,
       resources: noResources,
     });
     expect(created.diagnostics.map((d) => d.message)).toEqual([
-      expect.stringMatching(/'target' output, .* write Inputs: \[stim\.trigger\]/),
+      expect.stringMatching(
+        /the Stimulus's 'phase' output; write Inputs: \[stim\] or \[stim\.trigger\]/,
+      ),
     ]);
   });
 });

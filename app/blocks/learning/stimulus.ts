@@ -8,9 +8,20 @@ import {
   type Frame,
 } from "../../engine";
 import { timerInput } from "../shared/inputs";
+import { publish } from "../shared/named";
 import { SeededRandom } from "../shared/random";
 import { plural, TextThrottle } from "../shared/text";
 import { checkLabels, labelsSchema, seconds, targetVector, unknownLabel } from "./trigger";
+
+/**
+ * What a Stimulus offers by its name (shared/named.ts, kind "Stimulus"): its trigger frames (the
+ * `trigger` output's events) as they are sent, for a StimTrigger wired to its default output.
+ */
+export interface StimulusTriggers {
+  readonly targetWidth: number;
+  /** Calls `fn` with every trigger frame (borrowed: copy what you keep) before it is emitted. */
+  onTrigger(fn: (f: Frame) => void): () => void;
+}
 
 /** Most cues in one protocol (Tasks × Repetitions). */
 const MAX_CUES = 100_000;
@@ -296,6 +307,16 @@ export const Stimulus = defineBlock({
       trigLabel[trigN] = label;
       trigN++;
     };
+    // Blocks that read this Stimulus by name (a StimTrigger wired to its default output, as
+    // MOSAIC's files write it) get every trigger frame as it is sent.
+    const triggerListeners = new Set<(f: Frame) => void>();
+    const withdraw = publish(ctx, "Stimulus", {
+      targetWidth: T,
+      onTrigger(fn: (f: Frame) => void) {
+        triggerListeners.add(fn);
+        return () => triggerListeners.delete(fn);
+      },
+    } satisfies StimulusTriggers);
     const flushTrigger = (): void => {
       if (trigN === 0) return;
       const f = trigger.frame(trigN);
@@ -305,6 +326,7 @@ export const Stimulus = defineBlock({
         else f.v.set(targets[trigLabel[i]!]!, i * T);
       }
       trigN = 0;
+      for (const fn of triggerListeners) fn(f);
       trigger.emit(f);
     };
 
@@ -453,6 +475,10 @@ export const Stimulus = defineBlock({
         advance(Math.max(t, phaseStart), t);
         flushTrigger();
         describe(t);
+      },
+      dispose() {
+        withdraw();
+        triggerListeners.clear();
       },
       reset() {
         halt(started && p.Autostart ? "armed" : "idle");
