@@ -42,6 +42,7 @@ import { TAC } from "./learning/tac";
 import { Trigger } from "./learning/trigger";
 import { Logger } from "./recording/logger";
 import { AdaptiveFilter } from "./signal/adaptive-filter";
+import { DoubleDifferential } from "./signal/dds";
 import { ControlAlgorithm } from "./control/control-algorithm";
 import { Filter } from "./signal/filter";
 import { FunctionBlock } from "./signal/function";
@@ -70,6 +71,7 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   Filter,
   LinearMap,
   AdaptiveFilter,
+  DoubleDifferential,
   VectorialFunction,
   // Features
   MeanAbsoluteValue,

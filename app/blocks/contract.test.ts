@@ -300,6 +300,13 @@ const SETUPS: Record<string, Setup | Setup[]> = {
     { params: {}, inputs: [vec(3, 200)] },
     { params: { UseTimestamps: true, Derivative: "mosaic", G1: 2 }, inputs: [vec(2, 200)] },
   ],
+  ddS: [
+    { params: { Rows: 4, Columns: 2 }, inputs: [vec(8)] },
+    {
+      params: { Rows: 2, Columns: 3, Direction: "columns", Layout: "column-major" },
+      inputs: [mat(3, 6)],
+    },
+  ],
   MeanAbsoluteValue: feature(),
   RMS: feature(),
   WaveformLength: feature(),
