@@ -25,7 +25,7 @@ import {
 import { convertedWarning, paramKeyPositions, paramsText, readParams } from "./params";
 import { lineCounterOf, parseStage } from "./parse";
 import { LegacyParamsError } from "./legacy";
-import { positionalArgs } from "./positional";
+import { decimalCommaWarning, positionalArgs } from "./positional";
 import { BLOCK_NAME_RE, type BlockSpec, type LoadResult, type PipelineSettings } from "./spec";
 import { checkWiring } from "./wiring";
 
@@ -107,6 +107,7 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
 
     // Stage 4: params, positional ones as the original's blocks read them.
     const written = isSeq(keys.paramsNode) ? positionalArgs(keys.paramsNode) : undefined;
+    if (isSeq(keys.paramsNode)) decimalCommaWarning(c, name, keys.paramsNode);
     const rule = keys.rule;
     let args = written;
     let ruleOk = true;
