@@ -152,6 +152,78 @@ describe("UdpSender", () => {
     ]);
   });
 
+  test("several inputs (MOSAIC's sender subscribed to all): each with its own serializer, one counter", async () => {
+    const udp = fakeUdp();
+    const h = await BlockHarness.create(
+      UdpSender,
+      { Port: 11000 },
+      {
+        inputs: [
+          { shape: vectorShape(2), type: "ControlAlgorithm" },
+          { shape: vectorShape(3), type: "Joiner" },
+          { shape: vectorShape(1), type: "Resampler" },
+        ],
+        io: udp.io,
+      },
+    );
+    h.start();
+    h.push(Frame.from(vectorShape(2), [1], [[50, 75]]), 0);
+    h.push(Frame.from(vectorShape(3), [1.005], [[0.1, 0.2, 0.3]]), 1);
+    h.push(Frame.from(vectorShape(1), [1.04], [[0.7]]), 2);
+    expect(udp.sent.map(decode)).toEqual([
+      {
+        count: 1,
+        type: "f64",
+        category: 1,
+        subcategory: 0,
+        timestamp: 1,
+        counter: 0,
+        values: [50],
+      },
+      {
+        count: 1,
+        type: "f64",
+        category: 1,
+        subcategory: 1,
+        timestamp: 1,
+        counter: 1,
+        values: [75],
+      },
+      {
+        count: 3,
+        type: "f64",
+        category: 0,
+        subcategory: 1,
+        timestamp: 1.005,
+        counter: 2,
+        values: [0.1, 0.2, 0.3],
+      },
+      {
+        count: 1,
+        type: "f64",
+        category: 0,
+        subcategory: 2,
+        timestamp: 1.04,
+        counter: 3,
+        values: [0.7],
+      },
+    ]);
+    h.instance.stop?.();
+    expect(h.text).toMatch(/in0: control serializer.*in1: vector serializer.*4 datagrams sent/);
+  });
+
+  test("the original's cfg13 form loads: UDP_StreamlinedSender with three inputs", () => {
+    const src = `
+t: { Type: ScheduledTimer, DesiredRate: 100 }
+a: { Type: SinGenerator, Inputs: [t], Params: [2] }
+b: { Type: SinGenerator, Inputs: [t], Params: [3] }
+UDP_sender: { Type: UDP_StreamlinedSender, Inputs: [ a, b, t ], Params: [ localhost, 11000 ] }
+`;
+    const r = loadPipeline(src, "cfg13.yaml", createCatalog(BLOCKS));
+    expect(r.diagnostics.filter((d) => d.severity === "error")).toEqual([]);
+    expect(r.spec!.byName.get("UDP_sender")!.inputs.map((i) => i.block)).toEqual(["a", "b", "t"]);
+  });
+
   test("myo: signed bytes, value · 128, category 1, subcategory 1", async () => {
     const udp = fakeUdp();
     const h = await BlockHarness.create(

@@ -107,7 +107,17 @@ interface Plan {
   scale: number;
 }
 
-function plan(p: Params, size: number, sourceType: string | undefined): Plan {
+/**
+ * How input `index` of `inputs` is sent. With several inputs and no `Subcategory`, the vector
+ * serializer of input i writes subcategory i, so a receiver can tell the streams apart.
+ */
+function plan(
+  p: Params,
+  size: number,
+  sourceType: string | undefined,
+  index = 0,
+  inputs = 1,
+): Plan {
   const streamlinedOnly = ["Serializer", "ValueType", "Category", "Subcategory", "Subcategories"];
   if (p.Format !== "streamlined") {
     for (const k of streamlinedOnly) {
@@ -182,9 +192,18 @@ function plan(p: Params, size: number, sourceType: string | undefined): Plan {
     serializer,
     type: p.ValueType ?? (myo ? "i8" : "f64"),
     category: p.Category ?? (myo ? 1 : 0),
-    subcategories: [p.Subcategory ?? (myo ? 1 : 0)],
+    subcategories: [p.Subcategory ?? (myo ? 1 : inputs > 1 ? index : 0)],
     scale: p.Scale ?? (myo ? 128 : 1),
   };
+}
+
+/** One input's encoder. */
+interface Lane {
+  plan: Plan;
+  size: number;
+  perValue: boolean;
+  sEnc: StreamlinedEncoder | undefined;
+  rEnc: RawEncoder | undefined;
 }
 
 export const UdpSender = defineBlock({
@@ -205,7 +224,11 @@ export const UdpSender = defineBlock({
     "use. Formats **f32** and **f64** send bare " +
     "little-endian vectors, for peers that expect plain arrays. Nothing is sent in the browser " +
     "build (no sockets; the status says so); send errors (e.g. nothing listening) are counted " +
-    "and shown, never fatal. MOSAIC's positional form is `[hostIP, port]`.",
+    "and shown, never fatal. Several inputs (MOSAIC's sender subscribed to every input) are " +
+    "sent to the same destination, each with the serializer of its own source (MOSAIC chose " +
+    "one from the first input for all, and its vector serializer sent nothing), one counter " +
+    "for all datagrams; vector inputs get subcategory = their position in Inputs unless " +
+    "Subcategory says otherwise. MOSAIC's positional form is `[hostIP, port]`.",
   params,
   legacyParams(args) {
     if (args.length < 2) {
@@ -218,26 +241,36 @@ export const UdpSender = defineBlock({
     return { Host: host, Port: legacyInteger(args[1]!, "port", "Port") };
   },
   legacyForm: "[hostIP, port] (MOSAIC's UDP_StreamlinedSender; later arguments are ignored)",
-  inputs: { min: 1, max: 1, labels: ["signal"] },
+  inputs: { min: 1, max: Infinity, labels: ["signal"] },
   outputs: [],
   views: ["label"],
   panel: "Destination, datagrams sent and send errors.",
   create(ctx, p) {
-    const input = signalInput(ctx, 0);
-    const size = input.size;
-    const pl = plan(p, size, sourceTypeOf(input.info));
-    const dest = endpointText(p.Host, p.Port);
     const streamlined = p.Format === "streamlined";
-    const perValue = pl.serializer === "control";
-    const sEnc = streamlined ? new StreamlinedEncoder(perValue ? 1 : size, pl.type) : undefined;
-    const rEnc = streamlined ? undefined : new RawEncoder(size, p.Format as "f32" | "f64");
-    const subs = pl.subcategories;
-    const category = pl.category;
-    const scale = pl.scale;
+    const n = ctx.inputs.length;
+    const lanes: Lane[] = ctx.inputs.map((_, i) => {
+      const input = signalInput(ctx, i);
+      const pl = plan(p, input.size, sourceTypeOf(input.info), i, n);
+      const perValue = pl.serializer === "control";
+      return {
+        plan: pl,
+        size: input.size,
+        perValue,
+        sEnc: streamlined ? new StreamlinedEncoder(perValue ? 1 : input.size, pl.type) : undefined,
+        rEnc: streamlined ? undefined : new RawEncoder(input.size, p.Format as "f32" | "f64"),
+      };
+    });
+    /** MOSAIC's one counter over every datagram the block sends. */
+    let counter = 0;
+    const dest = endpointText(p.Host, p.Port);
     const sendTime = p.Timestamp === "send";
-    const what = streamlined
-      ? `${pl.serializer} serializer, ${pl.type}, category ${category}`
-      : `raw ${p.Format}`;
+    const laneText = (l: Lane): string =>
+      `${l.plan.serializer} serializer, ${l.plan.type}, category ${l.plan.category}`;
+    const what = !streamlined
+      ? `raw ${p.Format}`
+      : n === 1
+        ? laneText(lanes[0]!)
+        : lanes.map((l, i) => `${ctx.inputs[i]!.source}: ${laneText(l)}`).join("; ");
     const warns = new WarnLimiter(ctx);
     const throttle = new TextThrottle();
 
@@ -289,7 +322,7 @@ export const UdpSender = defineBlock({
           onError(e instanceof Error ? e.message : String(e));
         }
       },
-      process(f) {
+      process(f, port) {
         const s = socket;
         const n = f.n;
         if (!s) {
@@ -297,6 +330,10 @@ export const UdpSender = defineBlock({
           if (unavailable && n > 0 && throttle.due(f.t[n - 1]!)) describe();
           return;
         }
+        const lane = lanes[port]!;
+        const { rEnc, sEnc, size } = lane;
+        const { category, subcategories: subs, scale } = lane.plan;
+        if (sEnc) sEnc.counter = counter;
         const v = f.v;
         const stride = f.stride;
         for (let e = 0; e < n; e++) {
@@ -304,7 +341,7 @@ export const UdpSender = defineBlock({
           if (rEnc) {
             s.send(rEnc.encode(v, off, scale));
             sent++;
-          } else if (perValue) {
+          } else if (lane.perValue) {
             const t = sendTime ? ctx.now() : f.t[e]!;
             for (let k = 0; k < size; k++) {
               s.send(sEnc!.encode(t, category, subs[k]!, v, off + k, scale));
@@ -316,6 +353,7 @@ export const UdpSender = defineBlock({
             sent++;
           }
         }
+        if (sEnc) counter = sEnc.counter;
         if (n > 0 && throttle.due(f.t[n - 1]!)) describe();
       },
       stop() {
@@ -323,7 +361,7 @@ export const UdpSender = defineBlock({
         describe();
       },
       reset() {
-        if (sEnc) sEnc.counter = 0;
+        counter = 0;
         sent = 0;
         failed = 0;
         notSent = 0;
