@@ -4,6 +4,13 @@
  */
 import { createCatalog, type AnyBlockDefinition } from "../engine";
 import { Dasdv } from "./features/dasdv";
+import { Delsys } from "./devices/delsys";
+import { DLR_ADCBT } from "./devices/dlr-adcbt";
+import { ImuSimulator } from "./devices/imu-simulator";
+import { Muovi } from "./devices/muovi";
+import { MuoviSingleProbe } from "./devices/muovi-single-probe";
+import { NilsPod } from "./devices/nilspod";
+import { SimulatedOutput } from "./devices/simulated-output";
 import { FeatureSet } from "./features/feature-set";
 import { IntegratedAbsoluteValue } from "./features/integrated-absolute-value";
 import { MeanAbsoluteValue } from "./features/mean-absolute-value";
@@ -115,6 +122,14 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   HannesHand,
   HannesGUI,
   HannesReceiver,
+  // Devices (app/blocks/devices/)
+  Muovi,
+  MuoviSingleProbe,
+  Delsys,
+  DLR_ADCBT,
+  NilsPod,
+  ImuSimulator,
+  SimulatedOutput,
   // Recording
   Logger,
   // Testing

@@ -455,6 +455,32 @@ const SETUPS: Record<string, Setup | Setup[]> = {
     { params: { Port: 9 }, inputs: [timer(100)] },
     { params: { Port: 9, Channels: 8 }, inputs: [] },
   ],
+  // The original's timer-paced devices (app/blocks/devices/): no protocol yet, they send zeros.
+  Muovi: { params: { Probes: [0, 2] }, inputs: [timer(100)] },
+  MuoviSingleProbe: [
+    { params: {}, inputs: [timer(1000)] },
+    { params: { Probes: [1] }, inputs: [timer(2000)] },
+  ],
+  Delsys: { params: { Sensors: 4 }, inputs: [timer(1926)] },
+  DLR_ADCBT: { params: { Port: "COM5", Channels: 3 }, inputs: [timer(100)] },
+  NilsPod: { params: {}, inputs: [timer(100)] },
+  ImuSimulator: [
+    { params: {}, inputs: [timer(100)] },
+    { params: { Layout: "myo", NoiseStd: 0 }, inputs: [timer(50)] },
+  ],
+  SimulatedOutput: [
+    {
+      params: { Device: "BlenderArm", Destination: "localhost:3334", Unit: "datagram" },
+      inputs: [vec(11)],
+      silent: true,
+    },
+    {
+      params: { Device: "UdpSender", Count: "values" },
+      inputs: [vec(3), mat(2, 2)],
+      pattern: [0, 1, 1, 0],
+      silent: true,
+    },
+  ],
   // A source fed by its socket: nothing to feed here (tests/integration/udp.test.ts runs it).
   UdpReceiver: { params: { Port: 9, Channels: 3 }, inputs: [] },
   SerialPort: [

@@ -1,0 +1,73 @@
+import { z } from "zod";
+import { defineBlock, legacyInteger, LegacyParamsError, vectorShape } from "../../engine";
+import {
+  DLR_BAUD_RATE,
+  DLR_DEFAULT_CHANNELS,
+  DLR_MAX_CHANNELS,
+  dlrAdcBtProtocol,
+} from "./dlr-adcbt-protocol";
+import { pacedDevice, pacingTimer } from "./paced-device";
+
+const params = z.strictObject({
+  Port: z
+    .string()
+    .trim()
+    .max(256)
+    .default("")
+    .describe(
+      "The serial port (COM5, /dev/rfcomm0, /dev/ttyUSB0); empty: choose it in the control panel, as in the original",
+    ),
+  Channels: z
+    .number()
+    .int()
+    .min(1)
+    .max(DLR_MAX_CHANNELS)
+    .default(DLR_DEFAULT_CHANNELS)
+    .describe("Analog channels read (the output's width)"),
+});
+
+export const DLR_ADCBT = defineBlock({
+  type: "DLR_ADCBT",
+  category: "Devices",
+  summary: "Analog channels from the DLR ADC/BT converter over a serial port, paced by a timer.",
+  help:
+    "The DLR's ADC/BT analog-to-digital converter (e.g. force or FMG sensors) on a serial port " +
+    `(Bluetooth SPP or USB, ${DLR_BAUD_RATE} Bd), as MOSAIC's DLR_ADCBT: paced by one timer ` +
+    "input, every tick emits one vector [1, Channels] with the newest frame's values in volts " +
+    "(5 · raw / 4000, as the original). MOSAIC's positional form is `[COMport, numChannels]` " +
+    `(both optional; ${DLR_DEFAULT_CHANNELS} channels by default). The converter's protocol ` +
+    "comes in a later release: until then the block says that the device is not reachable and " +
+    "sends zeros, and `mosaic run --simulate-devices` (or the app's Simulate devices switch) " +
+    "replaces it by a simulated signal of the same shape and rate.",
+  params,
+  legacyParams(args) {
+    const port = (args[0] ?? "").trim();
+    const n = (args[1] ?? "").trim();
+    if (args.length > 2) {
+      throw new LegacyParamsError(
+        `expected [COMport, numChannels] (MOSAIC's DLR_ADCBT), got ${args.length} arguments`,
+      );
+    }
+    return {
+      ...(port !== "" ? { Port: port } : {}),
+      ...(n !== "" ? { Channels: legacyInteger(n, "numChannels", "Channels") } : {}),
+    };
+  },
+  legacyForm: `[COMport, numChannels], e.g. [COM5, 8] (both optional; ${DLR_DEFAULT_CHANNELS} channels)`,
+  inputs: { min: 1, max: 1, labels: ["timer"] },
+  outputs: ["analog"],
+  eventLoop: true,
+  views: ["scope"],
+  panel: "Scope of the channels; the link's state and frames received.",
+  create(ctx, p) {
+    pacingTimer(ctx);
+    const port = p.Port === "" ? "a serial port (none chosen: set Port)" : `serial port ${p.Port}`;
+    return pacedDevice(ctx, {
+      device: "DLR ADC/BT",
+      target: `the DLR ADC/BT on ${port} at ${DLR_BAUD_RATE} Bd`,
+      shape: vectorShape(p.Channels),
+      port: "analog",
+      protocol: dlrAdcBtProtocol(p),
+    });
+  },
+});
