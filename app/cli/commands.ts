@@ -11,6 +11,7 @@ import { dirname, join, resolve } from "node:path";
 import { parseArgs } from "node:util";
 import { formatDiagnostic } from "../engine/diagnostics";
 import { PipelineDocument } from "../engine/pipeline/document";
+import type { SimulateOptions } from "../engine/pipeline/simulate";
 import type { Telemetry } from "../engine/runtime/runtime";
 import { Host, webRoot } from "../host/host";
 import { serveStatic } from "../host/web-server";
@@ -22,9 +23,10 @@ const VERSION = "0.1.0";
 const HELP = `mosaic ${VERSION} — run MOSAIC pipelines headless
 
 Usage:
-  mosaic validate FILE...
+  mosaic validate FILE... [--simulate-devices [--keep-network]]
       Checks pipeline files (YAML syntax, block types, params, wiring, shapes, files they read).
-      Exit 0 when every file is valid, 2 otherwise; messages are file:line:col.
+      Exit 0 when every file is valid, 2 otherwise; messages are file:line:col. With
+      --simulate-devices, checks the pipeline as \`mosaic run --simulate-devices\` would run it.
   mosaic format FILE... [--check]
       Loads each pipeline through the editor's document model (the code the visual editor saves
       with) and writes it back in canonical form: a no-op on a valid file except that a missing
@@ -33,6 +35,7 @@ Usage:
       writes nothing and lists the files that would change (exit 1).
   mosaic run FILE [--duration S] [--clock realtime|virtual] [--json] [--precision]
                   [--batching-ms MS] [--log-dir DIR] [--start T] [--warmup S]
+                  [--simulate-devices [--keep-network]]
       Runs a pipeline and shows a live per-block table: desired and actual rate, status
       (on time, lagging, stumbling, idle), compute time and drops. --json prints one JSON object
       per line instead (telemetry at 20 Hz, events, a final summary). Ctrl-C stops cleanly and
@@ -47,15 +50,24 @@ Usage:
         --start T      virtual clock start time, UNIX seconds (default 0)
         --warmup S     reset the timing statistics (ΔT, lateness) after S seconds
         --telemetry-hz N  telemetry (status, rates) per second, default 20 (as the UI)
+        --simulate-devices  run without hardware: every device block becomes a simulator
+                       of the same output shape and rate (EmgSimulator for EMG armbands and
+                       probes, ImuSimulator for IMUs), every output device (BlenderArm, Hannes,
+                       UdpSender, ROS, a serial port that only writes) a SimulatedOutput that
+                       counts what it would have sent; one info line per block says what it
+                       became (docs/mosaic-compatibility.md lists them)
+        --keep-network  with --simulate-devices: keep the blocks that talk over UDP and ROS
+                       (BlenderArm, HannesGUI, UdpSender, ROS), so local receivers get the data
   mosaic web [--port N] [--host ADDR] [--pipeline FILE]
       Serves the browser build (dist/web: the UI with the engine in the page's Web Worker, on
       simulated signals) and prints its URL; --pipeline preselects one of pipelines/ (default
       the demo). Ctrl-C stops it.
-  mosaic serve [FILE] [--port N] [--host ADDR] [--no-start]
+  mosaic serve [FILE] [--port N] [--host ADDR] [--no-start] [--simulate-devices]
       Runs the engine here (with UDP, serial and the other device bridges) and serves the UI
       for it: the same page as \`mosaic web\`, connected over a WebSocket that needs the token
       in the printed URL. FILE is loaded and started (--no-start: only loaded); several tabs
       may watch the same engine. Binds 127.0.0.1 unless --host says otherwise.
+      --simulate-devices loads FILE with simulated devices (the page's switch does the same).
   mosaic bench [--duration S] [--warmup S] [--only NAME[,NAME]] [--out DIR] [--quick]
       Runs the standard benchmarks and writes bench/results/*.json and *.md.
   mosaic --help | --version
@@ -68,7 +80,35 @@ function err(s: string): void {
   process.stderr.write(s + "\n");
 }
 
-async function cmdValidate(files: string[]): Promise<number> {
+/** `--simulate-devices [--keep-network]` as the host's option (undefined: off). */
+function simulateOption(v: {
+  "simulate-devices"?: boolean;
+  "keep-network"?: boolean;
+}): SimulateOptions | undefined | string {
+  if (v["keep-network"] && !v["simulate-devices"]) {
+    return "--keep-network only applies with --simulate-devices";
+  }
+  return v["simulate-devices"] ? { keepNetwork: v["keep-network"] === true } : undefined;
+}
+
+const SIMULATE_ARGS = {
+  "simulate-devices": { type: "boolean", default: false },
+  "keep-network": { type: "boolean", default: false },
+} as const;
+
+async function cmdValidate(args: string[]): Promise<number> {
+  let files: string[];
+  let simulate: SimulateOptions | undefined;
+  try {
+    const r = parseArgs({ args, allowPositionals: true, options: SIMULATE_ARGS });
+    files = r.positionals;
+    const s = simulateOption(r.values);
+    if (typeof s === "string") throw new Error(s);
+    simulate = s;
+  } catch (e) {
+    err(`mosaic validate: ${(e as Error).message}`);
+    return 2;
+  }
   if (files.length === 0) {
     err("mosaic validate: give at least one pipeline file");
     return 2;
@@ -78,7 +118,7 @@ async function cmdValidate(files: string[]): Promise<number> {
   loadDspFromDisk();
   let bad = false;
   for (const f of files) {
-    const ds = await validatePipelineFile(f);
+    const ds = await validatePipelineFile(f, simulate);
     for (const d of ds) err(formatDiagnostic(d));
     const errors = ds.filter((d) => d.severity === "error").length;
     if (errors > 0) {
@@ -194,8 +234,14 @@ async function cmdRun(args: string[]): Promise<number> {
       start: { type: "string" },
       warmup: { type: "string" },
       "telemetry-hz": { type: "string" },
+      ...SIMULATE_ARGS,
     },
   });
+  const simulate = simulateOption(values);
+  if (typeof simulate === "string") {
+    err(`mosaic run: ${simulate}`);
+    return 2;
+  }
   const file = positionals[0];
   if (!file || positionals.length > 1) {
     err("usage: mosaic run FILE [--duration S] [--clock realtime|virtual] [--json]");
@@ -261,6 +307,7 @@ async function cmdRun(args: string[]): Promise<number> {
       virtualStart: start,
       telemetryHz,
       ...(mode === "virtual" && duration !== undefined ? { virtualDuration: duration } : {}),
+      ...(simulate ? { simulateDevices: simulate } : {}),
     },
     {
       // Only what is used: the JSON lines (printed as the workers encoded them), or the objects
@@ -407,6 +454,7 @@ async function cmdServe(args: string[]): Promise<number> {
       port: { type: "string", default: "8321" },
       host: { type: "string", default: "127.0.0.1" },
       "no-start": { type: "boolean", default: false },
+      "simulate-devices": { type: "boolean", default: false },
     },
   });
   const port = Number(values.port);
@@ -449,7 +497,12 @@ async function cmdServe(args: string[]): Promise<number> {
     return 1;
   }
   if (file && source !== undefined) {
-    const r = await served.hub.request({ type: "load", file, source });
+    const r = await served.hub.request({
+      type: "load",
+      file,
+      source,
+      ...(values["simulate-devices"] ? { simulateDevices: true } : {}),
+    });
     for (const d of r.diagnostics ?? []) err(formatDiagnostic(d));
     if (!r.ok) {
       await served.close();

@@ -3,7 +3,8 @@
  * parameter, says what was expected, and suggests the closest valid name for typos (DESIGN.md §2).
  */
 
-export type Severity = "error" | "warning";
+/** `info`: what a stage did on request (a simulated device), neither a problem nor a risk. */
+export type Severity = "error" | "warning" | "info";
 
 export interface Diagnostic {
   severity: Severity;

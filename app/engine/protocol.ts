@@ -9,6 +9,11 @@ import type { Diagnostic } from "./diagnostics";
 import type { Shape } from "./frame";
 import type { RuntimeEvent, Telemetry } from "./runtime/runtime";
 
+/**
+ * Version 1. Optional fields added to a message later (`load`'s `simulateDevices`) keep the
+ * version: an engine treats a missing field as before, and the UI and the engine it talks to come
+ * from the same build. A change that an older peer would misread raises it.
+ */
 export const PROTOCOL_VERSION = 1;
 
 // ---------------------------------------------------------------------------------------------
@@ -24,6 +29,11 @@ export const uiMessageSchema = z.discriminatedUnion("type", [
     id,
     file: z.string().min(1).max(4096),
     source: z.string().max(4_000_000),
+    /**
+     * Replace device blocks by simulators of the same shape and rate and output devices by
+     * counting sinks (app/engine/pipeline/simulate.ts); default false.
+     */
+    simulateDevices: z.boolean().optional(),
   }),
   z.strictObject({ type: z.literal("start"), id }),
   /** Every block type the engine knows, with its metadata (the editor's palette and forms). */
@@ -144,6 +154,8 @@ export interface CatalogInfo {
 export interface GraphInfo {
   file: string;
   blocks: BlockInfo[];
+  /** True when the pipeline was loaded with simulated devices. */
+  simulateDevices?: boolean;
 }
 
 export type EngineState = "empty" | "loaded" | "running" | "stopped" | "finished";

@@ -10,6 +10,7 @@ import type { Clock } from "./clock";
 import { errorMessage, type Diagnostic } from "./diagnostics";
 import type { Frame } from "./frame";
 import { loadPipeline, type PipelineSpec } from "./pipeline/loader";
+import { withSimulatedDevices } from "./pipeline/simulate";
 import {
   PROTOCOL_VERSION,
   parseUiMessage,
@@ -211,6 +212,8 @@ export class EngineSession {
   private loop: LoopHandle | undefined;
   private state: EngineState = "empty";
   private file = "";
+  /** The loaded pipeline runs with simulated devices. */
+  private simulated = false;
   private readonly watches = new Map<string, Watch>();
 
   constructor(
@@ -270,7 +273,11 @@ export class EngineSession {
         });
         return;
       case "load": {
-        const { diagnostics, graph } = await this.load(msg.file, msg.source);
+        const { diagnostics, graph } = await this.load(
+          msg.file,
+          msg.source,
+          msg.simulateDevices === true,
+        );
         const ok = graph !== undefined;
         this.reply(msg.id, ok, ok ? undefined : "the pipeline has errors", {
           diagnostics,
@@ -344,10 +351,16 @@ export class EngineSession {
   private async load(
     file: string,
     source: string,
+    simulateDevices = false,
   ): Promise<{ diagnostics: Diagnostic[]; graph?: GraphInfo }> {
     this.unload();
     this.file = file;
-    const loaded = loadPipeline(source, file, this.catalog);
+    this.simulated = simulateDevices;
+    const loaded = withSimulatedDevices(
+      loadPipeline(source, file, this.catalog),
+      this.catalog,
+      simulateDevices ? {} : undefined,
+    );
     if (!loaded.spec) {
       this.setState("empty");
       return { diagnostics: loaded.diagnostics };
@@ -457,7 +470,7 @@ export class EngineSession {
         ...(b.path !== undefined ? { path: b.path } : {}),
       };
     });
-    return { file: this.file, blocks };
+    return { file: this.file, blocks, ...(this.simulated ? { simulateDevices: true } : {}) };
   }
 
   private start(): void {

@@ -12,6 +12,7 @@ import { initDsp } from "../engine/dsp";
 import { errorMessage } from "../engine/diagnostics";
 import type { Frame, Shape } from "../engine/frame";
 import { loadPipeline } from "../engine/pipeline/loader";
+import { withSimulatedDevices } from "../engine/pipeline/simulate";
 import type { LogChannel, LogSink } from "../engine/runtime/logsink";
 import { Runtime, type Telemetry } from "../engine/runtime/runtime";
 import { SabRing } from "../engine/runtime/sab-ring";
@@ -84,7 +85,11 @@ async function create(msg: InitMessage): Promise<void> {
     });
     return;
   }
-  const loaded = loadPipeline(msg.source, msg.file, catalog);
+  const loaded = withSimulatedDevices(
+    loadPipeline(msg.source, msg.file, catalog),
+    catalog,
+    msg.simulateDevices,
+  );
   if (!loaded.spec) {
     post({ type: "failed", diagnostics: loaded.diagnostics });
     return;

@@ -10,6 +10,7 @@ import { fileURLToPath } from "node:url";
 import { Worker } from "node:worker_threads";
 import { errorMessage, type Diagnostic } from "../engine/diagnostics";
 import { shapeSize } from "../engine/frame";
+import type { SimulateOptions } from "../engine/pipeline/simulate";
 import type { Plan, RuntimeEvent, Telemetry } from "../engine/runtime/runtime";
 import { SabRing } from "../engine/runtime/sab-ring";
 import { serialHub } from "../../native-bridges/serial-proxy";
@@ -39,6 +40,8 @@ export interface HostOptions {
    * `Pipeline: { BatchingMs }` (undefined: the file's, else the default).
    */
   batchingS?: number;
+  /** Replace device blocks by simulators (`--simulate-devices`); undefined: off. */
+  simulateDevices?: SimulateOptions;
   workerPath?: string;
   wasmPath?: string;
 }
@@ -133,9 +136,10 @@ export class Host {
 
   private constructor(
     readonly file: string,
-    readonly options: Required<Omit<HostOptions, "logDir" | "batchingS">> & {
+    readonly options: Required<Omit<HostOptions, "logDir" | "batchingS" | "simulateDevices">> & {
       logDir: string;
       batchingS: number | undefined;
+      simulateDevices: SimulateOptions | undefined;
     },
   ) {
     this.logWriter = new LogWriter(
@@ -185,6 +189,7 @@ export class Host {
       virtualDuration: opts.virtualDuration ?? Infinity,
       telemetryHz: opts.telemetryHz ?? 20,
       batchingS: opts.batchingS,
+      simulateDevices: opts.simulateDevices,
       workerPath: opts.workerPath ?? defaultWorkerPath(),
       wasmPath: opts.wasmPath ?? defaultWasmPath(),
     });
@@ -205,6 +210,7 @@ export class Host {
       precision: host.options.precision,
       telemetryHz: host.options.telemetryHz,
       ...(host.options.batchingS !== undefined ? { batchingS: host.options.batchingS } : {}),
+      ...(host.options.simulateDevices ? { simulateDevices: host.options.simulateDevices } : {}),
     });
     // The main worker instantiates everything once to learn shapes and rates (the plan).
     const main = host.spawn("main");

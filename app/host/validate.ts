@@ -6,6 +6,7 @@ import { VirtualClock } from "../engine/clock";
 import type { Diagnostic } from "../engine/diagnostics";
 import { dspReady, initDsp } from "../engine/dsp";
 import { loadPipeline } from "../engine/pipeline/loader";
+import { withSimulatedDevices, type SimulateOptions } from "../engine/pipeline/simulate";
 import { Runtime } from "../engine/runtime/runtime";
 import { defaultWasmPath } from "./host";
 import { nodeResources } from "./resources";
@@ -16,7 +17,10 @@ export function loadDspFromDisk(path = defaultWasmPath()): void {
 }
 
 /** Parse, validate, then instantiate every block (shapes, files it reads) and dispose it again. */
-export async function validatePipelineFile(file: string): Promise<Diagnostic[]> {
+export async function validatePipelineFile(
+  file: string,
+  simulateDevices?: SimulateOptions,
+): Promise<Diagnostic[]> {
   let source: string;
   try {
     source = readFileSync(file, "utf8");
@@ -33,7 +37,11 @@ export async function validatePipelineFile(file: string): Promise<Diagnostic[]> 
       },
     ];
   }
-  const loaded = loadPipeline(source, file, catalog);
+  const loaded = withSimulatedDevices(
+    loadPipeline(source, file, catalog),
+    catalog,
+    simulateDevices,
+  );
   if (!loaded.spec) return loaded.diagnostics;
   loadDspFromDisk();
   const created = await Runtime.create({

@@ -1,5 +1,6 @@
 /** Messages between the host (main thread) and its engine workers. */
 import type { Diagnostic } from "../engine/diagnostics";
+import type { SimulateOptions } from "../engine/pipeline/simulate";
 import type { Shape } from "../engine/frame";
 import type { Plan, RuntimeEvent, Telemetry } from "../engine/runtime/runtime";
 import type { SabRingInit } from "../engine/runtime/sab-ring";
@@ -26,6 +27,8 @@ export interface InitMessage {
   telemetryHz: number;
   /** Batching interval for blocks without their own `BatchingMs`, s (the CLI's --batching-ms). */
   batchingS?: number;
+  /** Replace device blocks by simulators (`mosaic run --simulate-devices`); undefined: off. */
+  simulateDevices?: SimulateOptions;
 }
 
 /**

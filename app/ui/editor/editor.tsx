@@ -44,7 +44,7 @@ export interface EditorProps {
 export const EMPTY_FILE = "pipelines/untitled.yaml";
 
 const fromDiagnostic = (d: Diagnostic): EditIssue => ({
-  severity: d.severity,
+  severity: d.severity === "error" ? "error" : "warning",
   message: d.message + (d.suggestion !== undefined ? ` (did you mean '${d.suggestion}'?)` : ""),
   ...(d.block !== undefined ? { block: d.block } : {}),
   line: d.line,
@@ -82,7 +82,10 @@ export function Editor(props: EditorProps): ReactNode {
   const issues = useMemo(
     () =>
       applied.text === ed.text && applied.diagnostics.length > 0
-        ? [...ed.issues, ...applied.diagnostics.map(fromDiagnostic)]
+        ? [
+            ...ed.issues,
+            ...applied.diagnostics.filter((d) => d.severity !== "info").map(fromDiagnostic),
+          ]
         : ed.issues,
     [ed.issues, ed.text, applied],
   );
