@@ -104,7 +104,8 @@ function Shell({
   sharedEngine: boolean;
 }) {
   const client = useEngine();
-  const pipeline = usePipeline(client, initialPipeline);
+  // The browser build has no devices at all: it simulates them unless told otherwise.
+  const pipeline = usePipeline(client, initialPipeline, !sharedEngine);
   const { graph, generation } = pipeline;
   const state = useEngineState();
   const info = useEngineInfo();
@@ -418,6 +419,29 @@ function Shell({
           >
             Edit
           </button>
+          <label
+            className="toggle simulate-devices"
+            title={
+              "Replace device blocks (Myo, Muovi, Delsys, NilsPod, …) by simulators of the same " +
+              "shape and rate, and output devices (BlenderArm, Hannes, UDP, ROS) by blocks that " +
+              "count what they would have sent, so any pipeline runs without hardware. " +
+              "Changing it loads the pipeline again."
+            }
+          >
+            <input
+              type="checkbox"
+              checked={pipeline.simulateDevices}
+              disabled={pipeline.loading}
+              onChange={(e) => {
+                const on = e.target.checked;
+                pipeline.setSimulateDevices(on);
+                if (pipeline.file !== undefined && pipeline.source !== undefined) {
+                  void pipeline.loadSource(pipeline.file, pipeline.source, running);
+                }
+              }}
+            />
+            Simulate devices
+          </label>
           <span className="toolbar__spacer" />
           <span
             className={`timing ${info.sharedMemory ? "is-precise" : "is-coarse"}`}

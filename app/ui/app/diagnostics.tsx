@@ -13,6 +13,13 @@ export function Diagnostics({
 }) {
   if (diagnostics.length === 0 && error === undefined) return null;
   const errors = diagnostics.filter((d) => d.severity === "error").length;
+  const notes = diagnostics.filter((d) => d.severity === "info").length;
+  const warnings = diagnostics.length - errors - notes;
+  const count = (n: number, what: string): string => `${n} ${what}${n === 1 ? "" : "s"}`;
+  const loaded = [
+    ...(warnings > 0 || notes === 0 ? [count(warnings, "warning")] : []),
+    ...(notes > 0 ? [count(notes, "note")] : []),
+  ].join(" and ");
   return (
     <section
       className={`diagnostics${failed ? " is-failed" : ""}`}
@@ -21,9 +28,7 @@ export function Diagnostics({
       data-diagnostics={diagnostics.length}
     >
       <h2>
-        {failed
-          ? "The pipeline did not load"
-          : `${diagnostics.length} warning${diagnostics.length === 1 ? "" : "s"} while loading`}
+        {failed ? "The pipeline did not load" : `${loaded} while loading`}
         {failed && errors > 0 ? ` — ${errors} error${errors === 1 ? "" : "s"}` : ""}
       </h2>
       {error !== undefined ? <p className="diagnostics__error">{error}</p> : null}

@@ -28,11 +28,17 @@ export interface PipelineState {
   diagnostics: Diagnostic[];
   /** A problem that is not in the file (network, engine). */
   error: string | undefined;
+  /** Load with simulated devices (the toolbar's switch). */
+  simulateDevices: boolean;
 }
 
 export const DEFAULT_PIPELINE = "pipelines/demo.yaml";
 
-export function usePipeline(client: EngineClient, initial: string) {
+/**
+ * `simulateDevices`: the switch's first position (on in the browser build, which has no devices).
+ */
+export function usePipeline(client: EngineClient, initial: string, simulateDevices = false) {
+  const simulate = useRef(simulateDevices);
   const [s, setS] = useState<PipelineState>({
     index: [],
     selected: initial,
@@ -43,6 +49,7 @@ export function usePipeline(client: EngineClient, initial: string) {
     loading: false,
     diagnostics: [],
     error: undefined,
+    simulateDevices,
   });
   const busy = useRef(0);
 
@@ -66,7 +73,7 @@ export function usePipeline(client: EngineClient, initial: string) {
     async (file: string, source: string, autostart = true): Promise<Reply> => {
       const ticket = ++busy.current;
       setS((p) => ({ ...p, loading: true, file, error: undefined }));
-      const r = await client.load(file, source);
+      const r = await client.load(file, source, simulate.current);
       if (ticket !== busy.current) return { ok: false, message: "another load started" };
       setS((p) => ({
         ...p,
@@ -109,9 +116,16 @@ export function usePipeline(client: EngineClient, initial: string) {
 
   const select = useCallback((file: string) => setS((p) => ({ ...p, selected: file })), []);
 
+  /** The switch: later loads simulate devices (or not). */
+  const setSimulateDevices = useCallback((on: boolean) => {
+    simulate.current = on;
+    setS((p) => ({ ...p, simulateDevices: on }));
+  }, []);
+
   /** Shows a pipeline the (shared) engine already has, without loading anything. */
   const adopt = useCallback((graph: GraphInfo) => {
     busy.current++;
+    simulate.current = graph.simulateDevices === true;
     setS((p) => ({
       ...p,
       loading: false,
@@ -122,11 +136,12 @@ export function usePipeline(client: EngineClient, initial: string) {
       generation: p.generation + 1,
       diagnostics: [],
       error: undefined,
+      simulateDevices: graph.simulateDevices === true,
     }));
   }, []);
 
   // Another client of a shared engine (a tab, the desktop menu) loaded a pipeline: show it.
   useEffect(() => client.onRemoteGraph(adopt), [client, adopt]);
 
-  return { ...s, load, loadSource, select, adopt };
+  return { ...s, load, loadSource, select, adopt, setSimulateDevices };
 }

@@ -101,8 +101,14 @@ export class EngineClient {
     });
   }
 
-  async load(file: string, source: string): Promise<Reply> {
-    const r = await this.request({ type: "load", file, source });
+  /** Loads a pipeline; `simulateDevices` replaces its device blocks by simulators. */
+  async load(file: string, source: string, simulateDevices = false): Promise<Reply> {
+    const r = await this.request({
+      type: "load",
+      file,
+      source,
+      ...(simulateDevices ? { simulateDevices: true } : {}),
+    });
     this.graph = r.graph;
     for (const l of this.graphListeners) l(this.graph);
     return r;
