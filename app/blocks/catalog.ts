@@ -38,6 +38,9 @@ import { HannesGUI } from "./io/hannes-gui";
 import { HannesHand } from "./io/hannes-hand";
 import { HannesReceiver } from "./io/hannes-receiver";
 import { Python } from "./io/python";
+import { INmf } from "./learning/inmf";
+import { PythonNetLearning } from "./learning/python-net-learning";
+import { SimplePyTorch } from "./learning/simple-pytorch";
 import { SerialPort } from "./io/serial-port";
 import { UdpReceiver } from "./io/udp-receiver";
 import { UdpSender } from "./io/udp-sender";
@@ -50,6 +53,7 @@ import { Trigger } from "./learning/trigger";
 import { Logger } from "./recording/logger";
 import { AdaptiveFilter } from "./signal/adaptive-filter";
 import { DoubleDifferential } from "./signal/dds";
+import { PythonNetFiltUC } from "./signal/python-net-filt-uc";
 import { ControlAlgorithm } from "./control/control-algorithm";
 import { Filter } from "./signal/filter";
 import { FunctionBlock } from "./signal/function";
@@ -79,6 +83,7 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   LinearMap,
   AdaptiveFilter,
   DoubleDifferential,
+  PythonNetFiltUC,
   VectorialFunction,
   // Features
   MeanAbsoluteValue,
@@ -110,6 +115,9 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   BatchPredictor,
   IncrementalPredictor,
   Python,
+  PythonNetLearning,
+  SimplePyTorch,
+  INmf,
   // Control
   ControlAlgorithm,
   // Communication

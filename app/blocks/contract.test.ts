@@ -530,6 +530,31 @@ const SETUPS: Record<string, Setup | Setup[]> = {
       silent: true,
     },
   ],
+  // Python-backed blocks: their own output shapes do not fit the fake sidecar (which echoes its
+  // input's), so without a bridge (tests/integration/python-blocks.test.ts runs the real one).
+  PythonNetFiltUC: [
+    { params: { Frequency: 5 }, inputs: [vec(3)], io: instantPython },
+    {
+      params: { Filter: "notch", Q: 2, Frequency: 10, SampleRate: 200 },
+      inputs: [mat(4, 2, 50)],
+      silent: true,
+    },
+  ],
+  PythonNetLearning: {
+    params: { Buffer: "b", Method: "lda-predict" },
+    inputs: [vec(3)],
+    silent: true,
+  },
+  SimplePyTorch: { params: {}, inputs: [vec(5)], silent: true },
+  iNMF: [
+    { params: { Synergies: 2 }, inputs: [vec(4)], silent: true },
+    {
+      params: { Synergies: 2, Outputs: 12 },
+      inputs: [mat(5, 4), vec(4)],
+      pattern: [0, 1, 1],
+      silent: true,
+    },
+  ],
   // Setups that end idle (no capture or trial in progress): `reset` would send the stop.
   Trigger: {
     params: {
