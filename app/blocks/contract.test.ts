@@ -659,6 +659,20 @@ const SETUPS: Record<string, Setup | Setup[]> = {
         port === 1 ? (i % 14 === 4 ? [NaN] : [i / 10]) : smooth(i, port, size),
     },
     {
+      // LDA: two classes (one-hot targets) with an all-NaN stop every 9th event.
+      params: { Model: "lda", Shrinkage: 0.1 },
+      inputs: [vec(3), vec(2, 10)],
+      pattern: [1, 0, 0, 1, 0, 0, 0],
+      values: (i, port, size) =>
+        port === 1
+          ? i % 9 === 0
+            ? [NaN, NaN]
+            : i % 2 === 0
+              ? [1, 0]
+              : [0, 1]
+          : smooth(i, port, size),
+    },
+    {
       // Predicting only, with a model file: one sample x = (1, 2), y = 3, λ 1, no intercept.
       params: { File: "m.json" },
       inputs: [vec(2)],

@@ -303,4 +303,44 @@ describe("IncrementalPredictor", () => {
     const k = p.t.length - 1;
     for (let o = 0; o < 2; o++) expect(p.v[k]![o]).toBeCloseTo(y.v[k]![o]!, 6);
   });
+
+  test("IncrementalLDA (MOSAIC's name): classes are the targets, predictions their probabilities", async () => {
+    const yaml =
+      "T: { Type: ScheduledTimer, DesiredRate: 25 }\n" +
+      "F: { Type: SinGenerator, Inputs: [T], Params: { Components: 2 } }\n" +
+      "Y: { Type: SinGenerator, Inputs: [T], Params: { Components: 3 } }\n" +
+      "P: { Type: IncrementalPredictor, Inputs: [F, Y], Params: [IncrementalLDA, 2, 3] }\n";
+    expect(convertLegacy(yaml, "P")).toMatchObject({ Model: "lda", Inputs: 2, Outputs: 3 });
+    const h = await predictor({ Model: "lda" }, 2, 3);
+    // Two classes: "rest" (all zeros) around (0, 1), "power" [1, 1, 0] around (1, 0).
+    const rng = (i: number) => Math.sin(12.9898 * i) * 0.05;
+    let t = 0;
+    for (let i = 0; i < 40; i++) {
+      const rest = i % 2 === 0;
+      h.push(vectors([t], [rest ? [0, 0, 0] : [1, 1, 0]]), 1);
+      h.push(vectors([t + 0.001], [rest ? [rng(i), 1 + rng(i + 7)] : [1 + rng(i), rng(i + 7)]]), 0);
+      t += 0.04;
+    }
+    h.push(vectors([t], [[NaN, NaN, NaN]]), 1);
+    h.clear();
+    h.push(
+      vectors(
+        [t + 0.04, t + 0.08],
+        [
+          [0, 1],
+          [1, 0],
+        ],
+      ),
+      0,
+    );
+    const [rest, power] = h.output("prediction").v;
+    expect(rest![0]).toBeLessThan(1e-6);
+    expect(power![0]).toBeGreaterThan(1 - 1e-6);
+    expect(power![1]).toBeCloseTo(power![0]!, 12);
+    expect(power![2]).toBe(0);
+    expect(h.text).toMatch(/40 samples/);
+    await expect(predictor({ Model: "lda", AutoSave: true }, 2, 3)).rejects.toThrow(
+      /LDA models cannot be saved/,
+    );
+  });
 });

@@ -30,7 +30,7 @@ import {
 } from "./model-file";
 
 /** MOSAIC's incremental learning machines (Learning.cs). */
-const MACHINES = ["IncrementalRidgeRegression", "IncrementalRFF"] as const;
+const MACHINES = ["IncrementalRidgeRegression", "IncrementalRFF", "IncrementalLDA"] as const;
 
 const params = z.strictObject({
   ...modelParams,
@@ -69,7 +69,9 @@ export const IncrementalPredictor = defineBlock({
     "(learn from targets again), `pause` (ignore targets, keep predicting), `reset` (forget " +
     "everything), `save` and `load` (a file name, default File or <block>.model.json) and " +
     "`inspect`. MOSAIC's `[IncrementalRFF, 8, 12, λ, σ, D]` loads as the same model: γ = σ²/2, " +
-    "λ·2/D, no intercept.",
+    "λ·2/D, no intercept. MOSAIC's `[IncrementalLDA, 8, 12]` loads as `Model: lda`: MOSAIC's " +
+    "own IncrementalLDA learnt one class only and predicted a d-value 'velocity', so this is " +
+    "LDA as published (class means and a pooled covariance updated per sample), not its numbers.",
   params,
   legacyParams: (args) => {
     if (args.length === 0) {
@@ -92,8 +94,9 @@ export const IncrementalPredictor = defineBlock({
     return legacyMachine(args[0]!.trim(), args.slice(1, 3), args.slice(3), MACHINES);
   },
   legacyForm:
-    "[IncrementalRidgeRegression, d, M, λ?] or [IncrementalRFF, d, M, λ?, σ?, D?] (MOSAIC's " +
-    "machine, input and output sizes, hyper-parameters); the older [d, M] loads as IncrementalRFF",
+    "[IncrementalRidgeRegression, d, M, λ?], [IncrementalRFF, d, M, λ?, σ?, D?] or " +
+    "[IncrementalLDA, d, M] (MOSAIC's machine, input and output sizes, hyper-parameters); the " +
+    "older [d, M] loads as IncrementalRFF",
   inputs: { min: 1, max: 2, labels: ["features", "target"] },
   outputs: ["prediction", "fit"],
   views: ["scope", "spider", "label"],
@@ -117,6 +120,12 @@ export const IncrementalPredictor = defineBlock({
         `Outputs is ${p.Outputs} but the target input ${inputName(tgt.info)} carries ${tgt.size} ` +
           "values per event",
         "Outputs",
+      );
+    }
+    if (p.Model === "lda" && p.AutoSave) {
+      throw new BlockConfigError(
+        "AutoSave: LDA models cannot be saved to a model file yet (ridge and rff can)",
+        "AutoSave",
       );
     }
     let m: number | null = tgt?.size ?? p.Outputs ?? null;

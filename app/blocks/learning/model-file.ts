@@ -36,12 +36,37 @@ export const MAX_OUTPUTS = 4096;
 /** The model params both predictor blocks take (fields of their zod object). */
 export const modelParams = {
   Model: z
-    .enum(["ridge", "rff"])
+    .enum(["ridge", "rff", "lda"])
     .default("ridge")
     .describe(
       "ridge: linear ridge regression (paper eqs. 5–6); rff: ridge on random Fourier features " +
-        "(nonlinear, an RBF-kernel approximation). MOSAIC's names (IncrementalRidgeRegression, " +
-        "IncrementalRFF, RidgeRegression, RR_RFF) load through the positional form",
+        "(nonlinear, an RBF-kernel approximation); lda: linear discriminant analysis, a " +
+        "classifier whose classes are the distinct target vectors. MOSAIC's names " +
+        "(IncrementalRidgeRegression, IncrementalRFF, IncrementalLDA, RidgeRegression, RR_RFF) " +
+        "load through the positional form",
+    ),
+  Shrinkage: z
+    .number()
+    .min(0)
+    .max(1)
+    .default(0)
+    .describe(
+      "lda: α in [0, 1], the covariance used is (1 − α)Σ + α·(tr Σ/d)·I (scikit-learn's " +
+        "shrinkage; helps with few samples per input)",
+    ),
+  MaxClasses: z
+    .number()
+    .int()
+    .min(1)
+    .max(1024)
+    .default(32)
+    .describe("lda: most classes (distinct targets) kept; samples of further classes are refused"),
+  LdaOutput: z
+    .enum(["scores", "class"])
+    .default("scores")
+    .describe(
+      "lda: scores = the class targets weighted by their posterior probabilities (with one-hot " +
+        "targets, the class probabilities); class = the most probable class's target (one-hot)",
     ),
   Lambda: z
     .number()
@@ -134,6 +159,9 @@ export interface ModelParams {
   Gamma: number;
   Features: number;
   Seed: number;
+  Shrinkage: number;
+  MaxClasses: number;
+  LdaOutput: "scores" | "class";
   Forgetting: number;
   Intercept: boolean;
   Normalize: boolean;
@@ -156,7 +184,14 @@ export const MODEL_HELP =
   "input is only centred): for ridge exactly, as a penalty λ·sd² on each raw weight re-derived " +
   "whenever an sd moves by 10 % (the centring is the intercept's: without intercept the inputs " +
   "are only scaled); for rff the statistics freeze after `NormalizeSamples` training samples, " +
-  "which are then learnt again (a one-off cost of that many updates). Model files: JSON, see " +
+  "which are then learnt again (a one-off cost of that many updates). `lda` is linear " +
+  "discriminant analysis learnt per sample: the classes are the distinct target vectors (a " +
+  "one-hot eₖ, or MOSAIC's targets such as rest = all zeros), their means and the pooled " +
+  "within-class covariance are updated per sample (exactly the batch LDA of the samples so far, " +
+  "scikit-learn's LinearDiscriminantAnalysis with the lsqr solver and `Shrinkage`), and a " +
+  "prediction is the targets weighted by the class probabilities (`LdaOutput: scores`) or the " +
+  "most probable class's target (`class`); it has no λ, intercept, forgetting or normalisation, " +
+  "and no model file yet. Model files: JSON, see " +
   "docs/model-format.md; a file that does not match the inputs is refused with a message naming " +
   "the file and the mismatch.";
 
@@ -178,11 +213,17 @@ export function optionsFromParams(
     features: p.Features,
     gamma: p.Gamma,
     seed: p.Seed,
+    shrinkage: p.Shrinkage,
+    maxClasses: p.MaxClasses,
+    ldaOutput: p.LdaOutput,
   };
 }
 
 /** "rff (D 300, γ 0.5, λ 1)". */
 export function describeOptions(o: ResolvedLearningOptions): string {
+  if (o.kind === "lda") {
+    return `lda (${o.ldaOutput}${o.shrinkage > 0 ? `, shrinkage ${o.shrinkage}` : ""})`;
+  }
   const parts =
     o.kind === "rff" ? [`D ${o.features}`, `γ ${o.gamma}`, `λ ${o.lambda}`] : [`λ ${o.lambda}`];
   if (o.forgetting !== 1) parts.push(`β ${o.forgetting}`);
@@ -193,7 +234,10 @@ export function describeOptions(o: ResolvedLearningOptions): string {
 
 /** Which params a Rust error is about (for BlockConfigError). */
 function paramOf(message: string): string | undefined {
-  const m = /^(Lambda|Gamma|Features|Forgetting|Inputs|Outputs|NormalizeSamples)\b/.exec(message);
+  const m =
+    /^(Lambda|Gamma|Features|Forgetting|Inputs|Outputs|NormalizeSamples|Normalize|Shrinkage|MaxClasses)\b/.exec(
+      message,
+    );
   return m?.[1];
 }
 
@@ -232,6 +276,15 @@ export function legacyMachine(
   }
   const inputs = legacyInteger(dims[0]!, "input size", "Inputs");
   const outputs = legacyInteger(dims[1]!, "output size", "Outputs");
+  if (name.includes("LDA")) {
+    // The original's IncrementalLDA took no hyper-parameters (it ignored any).
+    if (hyper.length > 0) {
+      throw new LegacyParamsError(
+        `${name} takes no hyper-parameters (MOSAIC ignored them); got [${hyper.join(", ")}]`,
+      );
+    }
+    return { Model: "lda", Inputs: inputs, Outputs: outputs };
+  }
   const lambda = hyper[0] !== undefined ? legacyNumber(hyper[0], "lambda", "Lambda") : 1;
   const rff = name.includes("RFF");
   if (!rff) {
@@ -319,6 +372,11 @@ function matrix(v: ArrayLike<number>, at: number, rows: number, cols: number, in
 /** Writes a model as a model file (text). */
 export function serializeModel(model: LearningModel, meta: ModelFileMeta): string {
   const o = model.options;
+  if (o.kind === "lda") {
+    throw new Error(
+      "LDA models cannot be saved to a model file yet (the format, docs/model-format.md, holds ridge and rff models)",
+    );
+  }
   const p = model.dim;
   const m = o.outputs;
   const d = o.inputs;
@@ -528,6 +586,9 @@ export function parseModelFile(text: string, file: string): ModelFile {
     features: LEARNING_DEFAULTS.features,
     gamma: LEARNING_DEFAULTS.gamma,
     seed: 0,
+    shrinkage: LEARNING_DEFAULTS.shrinkage,
+    maxClasses: LEARNING_DEFAULTS.maxClasses,
+    ldaOutput: LEARNING_DEFAULTS.ldaOutput,
   };
   if (rff) {
     options.gamma = c.number(top.gamma, "gamma", (x) => x > 0, "a number > 0");

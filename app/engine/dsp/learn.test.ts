@@ -280,3 +280,45 @@ describe("LearningModel contracts", () => {
     }
   });
 });
+
+interface LdaCase {
+  name: string;
+  shrinkage: number;
+  d: number;
+  m: number;
+  x: number[];
+  y: number[];
+  xt: number[];
+  scores: number[];
+  class: number[];
+}
+
+describe("LearningModel kind lda (wasm) vs scikit-learn (lda.json, from gen_lda.py)", () => {
+  const lda = JSON.parse(readFileSync(join(FIXTURES, "lda.json"), "utf8")) as { cases: LdaCase[] };
+  it.each(lda.cases)("$name: trained sample by sample while predicting, then predicting", (c) => {
+    for (const output of ["scores", "class"] as const) {
+      const model = new LearningModel({
+        kind: "lda",
+        inputs: c.d,
+        outputs: c.m,
+        shrinkage: c.shrinkage,
+        maxClasses: 8,
+        ldaOutput: output,
+      });
+      const n = c.x.length / c.d;
+      const out = new Float64Array(c.m);
+      for (let i = 0; i < n; i++) {
+        const x = Float64Array.from(c.x.slice(i * c.d, (i + 1) * c.d));
+        model.trainPredict(x, c.y.slice(i * c.m, (i + 1) * c.m), out, 1);
+      }
+      expect(model.samplesSeen()).toBe(n);
+      const nt = c.xt.length / c.d;
+      const got = new Float64Array(nt * c.m);
+      model.predict(Float64Array.from(c.xt), got, nt);
+      const want = output === "scores" ? c.scores : c.class;
+      const err = Math.max(...Array.from(got, (v, i) => Math.abs(v - want[i]!)));
+      expect(err).toBeLessThanOrEqual(1e-9);
+      model.dispose();
+    }
+  });
+});

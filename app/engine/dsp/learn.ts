@@ -1,6 +1,6 @@
 /**
  * TypeScript face of the Rust learning core (`core-wasm/learn`, crate mosaic-learn): ridge
- * regression and random Fourier features, batch and incremental, for the BatchPredictor and
+ * regression, random Fourier features and LDA, batch and incremental, for the BatchPredictor and
  * IncrementalPredictor blocks. Call `initDsp` first (the learning kernels live in the same module).
  *
  * Math (details in the Rust docs, `cargo doc -p mosaic-learn`): ŷ = Wᵀx + b with W solving the
@@ -9,6 +9,10 @@
  * MOSAIC 1). Incremental learning updates a Cholesky factor of the normal equations by one
  * rank-one update per sample (exact, O(p²)); `forgetting` β < 1 weighs sample i of n by β^(n−1−i).
  * RFF maps x to z = √(2/D)·cos(Ωx + b), Ω ~ N(0, 2γ) (scikit-learn's `RBFSampler`), then ridge.
+ * LDA (kind `lda`) is linear discriminant analysis learnt per sample: the classes are the distinct
+ * target vectors, their means and the pooled within-class covariance are updated per sample
+ * (scikit-learn's `LinearDiscriminantAnalysis`, solver lsqr), and a prediction is the targets
+ * weighted by the class probabilities (`ldaOutput: scores`) or the most probable class's target.
  *
  * Buffers are row-major: `nEvents` inputs are `nEvents × inputs` values, predictions
  * `nEvents × outputs`. Nothing is allocated per call in steady state.
@@ -26,7 +30,7 @@ import {
   Scratch,
 } from "./memory";
 
-export type ModelKindName = "ridge" | "rff";
+export type ModelKindName = "ridge" | "rff" | "lda";
 
 export interface LearningModelOptions {
   kind: ModelKindName;
@@ -50,6 +54,12 @@ export interface LearningModelOptions {
   gamma?: number;
   /** RFF: seed of Ω and b, an integer from 0 to 2^53 − 1 (default 0). */
   seed?: number;
+  /** LDA: shrinkage α in [0, 1] of the pooled covariance (default 0). */
+  shrinkage?: number;
+  /** LDA: most classes (distinct targets) kept, 1 … 1024 (default 32). */
+  maxClasses?: number;
+  /** LDA: `scores` (targets weighted by the class probabilities, default) or `class`. */
+  ldaOutput?: "scores" | "class";
 }
 
 /** Defaults of the optional options (the same as the Rust crate's). */
@@ -62,6 +72,9 @@ export const LEARNING_DEFAULTS = {
   features: 300,
   gamma: 0.5,
   seed: 0,
+  shrinkage: 0,
+  maxClasses: 32,
+  ldaOutput: "scores",
 } as const;
 
 export type ResolvedLearningOptions = Required<LearningModelOptions>;
@@ -103,8 +116,10 @@ export class LearningModel {
   constructor(options: LearningModelOptions) {
     requireReady("LearningModel");
     const o: ResolvedLearningOptions = { ...LEARNING_DEFAULTS, ...options };
-    if (o.kind !== "ridge" && o.kind !== "rff") {
-      throw new Error(`LearningModel: unknown kind '${String(o.kind)}'; expected ridge or rff`);
+    if (o.kind !== "ridge" && o.kind !== "rff" && o.kind !== "lda") {
+      throw new Error(
+        `LearningModel: unknown kind '${String(o.kind)}'; expected ridge, rff or lda`,
+      );
     }
     checkSize("LearningModel", "inputs", o.inputs, 1 << 22);
     checkSize("LearningModel", "outputs", o.outputs, 4096);
@@ -129,6 +144,9 @@ export class LearningModel {
         o.gamma,
         Math.floor(o.seed / 2 ** 32),
         o.seed % 2 ** 32,
+        o.shrinkage,
+        intOr0(o.maxClasses),
+        o.ldaOutput === "class",
         INITIAL_CAPACITY,
       );
     } catch (e) {
@@ -312,7 +330,8 @@ export class LearningModel {
 }
 
 export interface LearningBenchFigure {
-  kind: ModelKindName;
+  /** The bench times the regressions (an LDA update costs a ridge's plus its re-solve). */
+  kind: "ridge" | "rff";
   /** Dimension of the normal equations: inputs for ridge, features for RFF. */
   dim: number;
   inputs: number;

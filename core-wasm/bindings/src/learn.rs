@@ -5,7 +5,7 @@
 //! (never a `Result`, which wasm-bindgen returns through a fresh array), and
 //! reads the results. `ensure_*` may move the buffers.
 
-use mosaic_learn::{LearnError, Model, ModelConfig, PredictingMachine};
+use mosaic_learn::{LdaOutput, LearnError, Model, ModelConfig, PredictingMachine};
 use wasm_bindgen::prelude::*;
 
 fn js_err(e: LearnError) -> JsError {
@@ -16,7 +16,7 @@ fn zeros(len: usize) -> Vec<f64> {
     vec![0.0; len]
 }
 
-/// A learning machine (ridge or RFF) with its buffers.
+/// A learning machine (ridge, RFF or LDA) with its buffers.
 #[wasm_bindgen]
 pub struct WasmLearner {
     model: Model,
@@ -38,9 +38,11 @@ pub struct WasmLearner {
 
 #[wasm_bindgen]
 impl WasmLearner {
-    /// `kind` is `ridge` or `rff`; `features`, `gamma` and the seed
+    /// `kind` is `ridge`, `rff` or `lda`; `features`, `gamma` and the seed
     /// (`seed_hi · 2³² + seed_lo`) are used by `rff` only;
-    /// `normalize_samples` by `rff` with `normalize` only.
+    /// `normalize_samples` by `rff` with `normalize` only; `shrinkage`,
+    /// `max_classes` and `lda_class` (predict the most probable class's
+    /// target instead of the probability-weighted targets) by `lda` only.
     #[wasm_bindgen(constructor)]
     #[allow(clippy::too_many_arguments)]
     pub fn new(
@@ -56,6 +58,9 @@ impl WasmLearner {
         gamma: f64,
         seed_hi: u32,
         seed_lo: u32,
+        shrinkage: f64,
+        max_classes: usize,
+        lda_class: bool,
         capacity_events: usize,
     ) -> Result<WasmLearner, JsError> {
         let base = match kind {
@@ -64,9 +69,17 @@ impl WasmLearner {
                 .features(features)
                 .gamma(gamma)
                 .seed((u64::from(seed_hi) << 32) | u64::from(seed_lo)),
+            "lda" => ModelConfig::lda(inputs, outputs)
+                .shrinkage(shrinkage)
+                .max_classes(max_classes)
+                .lda_output(if lda_class {
+                    LdaOutput::Class
+                } else {
+                    LdaOutput::Scores
+                }),
             other => {
                 return Err(JsError::new(&format!(
-                    "unknown model '{other}'; expected ridge or rff"
+                    "unknown model '{other}'; expected ridge, rff or lda"
                 )))
             }
         };

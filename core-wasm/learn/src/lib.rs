@@ -24,8 +24,11 @@
 //!   plane rotations, O(p²) per sample, with an optional forgetting factor.
 //! * [`RandomFourierFeatures`] — z(x) = √(2/D)·cos(Ωx + b) (scikit-learn's
 //!   `RBFSampler`), then [`Ridge`] on z.
-//! * [`Model`] — either of them from a [`ModelConfig`], with an optional
-//!   running standardisation of the inputs.
+//! * [`Lda`] — linear discriminant analysis learnt per sample (class means and a
+//!   pooled covariance), predicting class scores or the most probable class's
+//!   target (MOSAIC 1's IncrementalLDA, done properly).
+//! * [`Model`] — any of them from a [`ModelConfig`], with an optional
+//!   running standardisation of the inputs (ridge and RFF).
 //!
 //! ```
 //! use mosaic_learn::{ModelConfig, PredictingMachine};
@@ -48,6 +51,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod error;
+mod lda;
 mod linalg;
 mod model;
 mod rff;
@@ -55,6 +59,7 @@ mod ridge;
 mod state;
 
 pub use error::LearnError;
+pub use lda::{Lda, LdaOutput, LdaParams, MAX_CLASSES};
 pub use model::{Model, ModelConfig, ModelKind};
 pub use rff::{RandomFourierFeatures, RffParams};
 pub use ridge::{Ridge, RidgeParams};

@@ -1,3 +1,4 @@
+use crate::lda::{Lda, LdaOutput, LdaParams};
 use crate::ridge::{check_pairs, usable};
 use crate::state::{Reader, Writer};
 use crate::{
@@ -11,6 +12,8 @@ pub enum ModelKind {
     Ridge,
     /// Ridge regression on random Fourier features ([`RandomFourierFeatures`]).
     Rff(RffParams),
+    /// Incremental linear discriminant analysis ([`Lda`]): classes are the distinct targets.
+    Lda(LdaParams),
 }
 
 /// Everything that defines a [`Model`]; built with a small builder.
@@ -60,6 +63,39 @@ impl ModelConfig {
             kind: ModelKind::Rff(RffParams::default()),
             ..Self::ridge(inputs, outputs)
         }
+    }
+
+    /// Incremental LDA with the default [`LdaParams`] (λ, forgetting and intercept do not
+    /// apply; `normalize` is refused: LDA does not depend on the inputs' scales).
+    pub fn lda(inputs: usize, outputs: usize) -> Self {
+        ModelConfig {
+            kind: ModelKind::Lda(LdaParams::default()),
+            ..Self::ridge(inputs, outputs)
+        }
+    }
+
+    /// Sets the LDA shrinkage α (LDA only).
+    pub fn shrinkage(mut self, alpha: f64) -> Self {
+        if let ModelKind::Lda(p) = &mut self.kind {
+            p.shrinkage = alpha;
+        }
+        self
+    }
+
+    /// Sets the most classes an LDA keeps (LDA only).
+    pub fn max_classes(mut self, k: usize) -> Self {
+        if let ModelKind::Lda(p) = &mut self.kind {
+            p.max_classes = k;
+        }
+        self
+    }
+
+    /// Sets what an LDA predicts (LDA only).
+    pub fn lda_output(mut self, output: LdaOutput) -> Self {
+        if let ModelKind::Lda(p) = &mut self.kind {
+            p.output = output;
+        }
+        self
     }
 
     /// Sets λ.
@@ -260,13 +296,26 @@ impl Standardizer {
 enum Machine {
     Ridge(Ridge),
     Rff(RandomFourierFeatures),
+    Lda(Lda),
 }
 
 fn refuse(machine: &mut Machine) {
     match machine {
         Machine::Ridge(r) => r.refuse(),
         Machine::Rff(f) => f.ridge_mut().refuse(),
+        Machine::Lda(l) => l.refuse(),
     }
+}
+
+/// A batch fit of an LDA: its statistics are sufficient, so it is the rows learnt in order.
+fn fit_lda(l: &mut Lda, x: &[f64], y: &[f64], d: usize, m: usize) -> usize {
+    l.reset();
+    let n = x.len() / d;
+    let mut used = 0;
+    for i in 0..n {
+        used += l.learn_one(&x[i * d..(i + 1) * d], &y[i * m..(i + 1) * m]) as usize;
+    }
+    used
 }
 
 /// A learning machine built from a [`ModelConfig`]: ridge or RFF, with an
@@ -333,10 +382,28 @@ impl Model {
                 p,
                 config.ridge,
             )?),
+            ModelKind::Lda(p) => {
+                if config.normalize {
+                    return Err(LearnError::InvalidParameter {
+                        name: "Normalize",
+                        value: 1.0,
+                        expected:
+                            "false for LDA (its predictions do not depend on the inputs' scales)",
+                    });
+                }
+                if config.ridge.forgetting != 1.0 {
+                    return Err(LearnError::InvalidParameter {
+                        name: "Forgetting",
+                        value: config.ridge.forgetting,
+                        expected: "1 for LDA (it keeps every sample's statistics)",
+                    });
+                }
+                Machine::Lda(Lda::new(config.inputs, config.outputs, p)?)
+            }
         };
         let d = config.inputs;
         let warmup = match config.kind {
-            ModelKind::Ridge => 0,
+            ModelKind::Ridge | ModelKind::Lda(_) => 0,
             ModelKind::Rff(_) => {
                 let k = config.normalize_samples;
                 if config.normalize && !(2..=MAX_WARMUP).contains(&k) {
@@ -364,47 +431,73 @@ impl Model {
         &self.config
     }
 
-    /// The ridge stage (on the inputs, or on the random features).
-    pub fn ridge(&self) -> &Ridge {
+    /// The ridge stage (on the inputs, or on the random features); None for LDA.
+    pub fn ridge(&self) -> Option<&Ridge> {
         match &self.machine {
-            Machine::Ridge(r) => r,
-            Machine::Rff(f) => f.ridge(),
+            Machine::Ridge(r) => Some(r),
+            Machine::Rff(f) => Some(f.ridge()),
+            Machine::Lda(_) => None,
         }
     }
 
     /// The feature map, for an RFF model.
     pub fn rff(&self) -> Option<&RandomFourierFeatures> {
         match &self.machine {
-            Machine::Ridge(_) => None,
             Machine::Rff(f) => Some(f),
+            _ => None,
         }
     }
 
-    /// p, the dimension the ridge works in (d, or D for RFF).
+    /// The LDA, for an LDA model.
+    pub fn lda(&self) -> Option<&Lda> {
+        match &self.machine {
+            Machine::Lda(l) => Some(l),
+            _ => None,
+        }
+    }
+
+    /// p, the dimension the ridge works in (d, or D for RFF; d for LDA).
     pub fn dim(&self) -> usize {
-        self.ridge().inputs()
+        match &self.machine {
+            Machine::Ridge(r) => r.inputs(),
+            Machine::Rff(f) => f.ridge().inputs(),
+            Machine::Lda(l) => l.inputs(),
+        }
     }
 
-    /// R² per output (see [`Ridge::r2`]); NaN while undefined.
+    /// R² per output (see [`Ridge::r2`], [`Lda::r2`]); NaN while undefined.
     pub fn r2(&self, out: &mut [f64]) {
-        self.ridge().r2(out);
+        match &self.machine {
+            Machine::Ridge(r) => r.r2(out),
+            Machine::Rff(f) => f.ridge().r2(out),
+            Machine::Lda(l) => l.r2(out),
+        }
     }
 
-    /// The regulariser in use (see [`Ridge::effective_lambda`]).
+    /// The regulariser in use (see [`Ridge::effective_lambda`]); an LDA's shrinkage.
     pub fn effective_lambda(&self) -> f64 {
-        self.ridge().effective_lambda()
+        match &self.machine {
+            Machine::Ridge(r) => r.effective_lambda(),
+            Machine::Rff(f) => f.ridge().effective_lambda(),
+            Machine::Lda(l) => l.params().shrinkage,
+        }
     }
 
-    /// Samples refused (NaN, infinity, beyond ±1e50).
+    /// Samples refused (NaN, infinity, beyond ±1e50; for LDA also classes beyond MaxClasses).
     pub fn rejected(&self) -> u64 {
-        self.ridge().rejected()
+        match &self.machine {
+            Machine::Ridge(r) => r.rejected(),
+            Machine::Rff(f) => f.ridge().rejected(),
+            Machine::Lda(l) => l.rejected(),
+        }
     }
 
-    /// See [`Ridge::refactor`].
+    /// See [`Ridge::refactor`] (nothing to do for LDA, which solves lazily).
     pub fn refactor(&mut self) {
         match &mut self.machine {
             Machine::Ridge(r) => r.refactor(),
             Machine::Rff(f) => f.ridge_mut().refactor(),
+            Machine::Lda(_) => {}
         }
     }
 
@@ -450,6 +543,7 @@ impl Model {
             return match machine {
                 Machine::Ridge(r) => r.learn_one(x, y),
                 Machine::Rff(f) => f.learn_one(x, y),
+                Machine::Lda(l) => l.learn_one(x, y),
             };
         };
         if !(usable(x) && usable(y)) {
@@ -495,12 +589,15 @@ impl Model {
                 s.transform(x, xs);
                 f.learn_one(xs, y)
             }
+            // Refused at construction: LDA is never normalised.
+            Machine::Lda(l) => l.learn_one(x, y),
         }
     }
 
     fn predict_one(&mut self, x: &[f64], out: &mut [f64]) {
         match &mut self.machine {
             Machine::Ridge(r) => r.predict_one(x, out),
+            Machine::Lda(l) => l.predict_one(x, out),
             Machine::Rff(f) => match &self.norm {
                 Some(s) => {
                     s.transform(x, &mut self.xs);
@@ -550,6 +647,7 @@ impl Model {
         match &self.machine {
             Machine::Ridge(r) => r.sections(&mut v),
             Machine::Rff(f) => f.sections(&mut v),
+            Machine::Lda(l) => l.sections(&mut v),
         }
         v
     }
@@ -565,7 +663,11 @@ impl PredictingMachine for Model {
     }
 
     fn samples_seen(&self) -> u64 {
-        self.ridge().samples_seen()
+        match &self.machine {
+            Machine::Ridge(r) => r.samples_seen(),
+            Machine::Rff(f) => f.ridge().samples_seen(),
+            Machine::Lda(l) => l.samples_seen(),
+        }
     }
 
     fn predict(&mut self, x: &[f64], y: &mut [f64]) -> Result<(), LearnError> {
@@ -629,6 +731,7 @@ impl PredictingMachine for Model {
                             ok(i)
                         })
                     }
+                    Machine::Lda(l) => fit_lda(l, x, y, d, m),
                 }
             }
             None => {
@@ -639,6 +742,7 @@ impl PredictingMachine for Model {
                 match machine {
                     Machine::Ridge(r) => r.fit_rows(n, y, f),
                     Machine::Rff(r) => r.fit_rows(n, y, f),
+                    Machine::Lda(l) => fit_lda(l, x, y, d, m),
                 }
             }
         };
@@ -662,6 +766,7 @@ impl PredictingMachine for Model {
                 }
                 f.reset();
             }
+            Machine::Lda(l) => l.reset(),
         }
     }
 
@@ -674,6 +779,7 @@ impl PredictingMachine for Model {
         norm + match &self.machine {
             Machine::Ridge(r) => r.state_len_inner(),
             Machine::Rff(f) => f.state_len_inner(),
+            Machine::Lda(l) => l.state_len_inner(),
         }
     }
 
@@ -685,6 +791,7 @@ impl PredictingMachine for Model {
         match &self.machine {
             Machine::Ridge(r) => r.save(&mut w),
             Machine::Rff(f) => f.save(&mut w),
+            Machine::Lda(l) => l.save(&mut w),
         }
         Ok(())
     }
@@ -698,6 +805,7 @@ impl PredictingMachine for Model {
         match &mut self.machine {
             Machine::Ridge(r) => r.load(&mut rd)?,
             Machine::Rff(f) => f.load(&mut rd)?,
+            Machine::Lda(l) => l.load(&mut rd)?,
         }
         self.norm = norm;
         Ok(())

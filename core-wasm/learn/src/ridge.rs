@@ -66,15 +66,15 @@ impl RidgeParams {
 /// Running statistics behind the reported R²: weighted mean and scatter of
 /// the targets and the weighted sum of squared residuals, per output.
 #[derive(Debug, Clone)]
-struct FitStats {
-    weight: f64,
-    mean: Vec<f64>,
-    m2: Vec<f64>,
-    sse: Vec<f64>,
+pub(crate) struct FitStats {
+    pub(crate) weight: f64,
+    pub(crate) mean: Vec<f64>,
+    pub(crate) m2: Vec<f64>,
+    pub(crate) sse: Vec<f64>,
 }
 
 impl FitStats {
-    fn new(m: usize) -> Self {
+    pub(crate) fn new(m: usize) -> Self {
         FitStats {
             weight: 0.0,
             mean: vec![0.0; m],
@@ -83,7 +83,7 @@ impl FitStats {
         }
     }
 
-    fn clear(&mut self) {
+    pub(crate) fn clear(&mut self) {
         self.weight = 0.0;
         self.mean.fill(0.0);
         self.m2.fill(0.0);
@@ -92,7 +92,7 @@ impl FitStats {
 
     /// One target `y` with residual `e`, sample weight `w`, older samples
     /// scaled by `beta`.
-    fn add(&mut self, y: &[f64], e: &[f64], w: f64, beta: f64) {
+    pub(crate) fn add(&mut self, y: &[f64], e: &[f64], w: f64, beta: f64) {
         // Residuals of a hopeless model (conditioning beyond 1e100) could overflow e²: such a
         // sample is left out of the statistics, which are diagnostics only.
         if !e.iter().chain(y).all(|v| (v * v).is_finite()) {
@@ -109,7 +109,7 @@ impl FitStats {
         self.weight = new;
     }
 
-    fn r2(&self, out: &mut [f64]) {
+    pub(crate) fn r2(&self, out: &mut [f64]) {
         for o in 0..out.len() {
             out[o] = if self.m2[o] > 0.0 {
                 1.0 - self.sse[o] / self.m2[o]

@@ -268,13 +268,16 @@ fn normalized_batch_equals_standard_scaler_and_ridge() {
             }
         }
         let pen: Vec<f64> = scale.iter().map(|s| s * s).collect();
-        assert!(rel(m.ridge().penalty(), &pen) < 1e-12, "{name}: penalty");
+        assert!(
+            rel(m.ridge().unwrap().penalty(), &pen) < 1e-12,
+            "{name}: penalty"
+        );
         let mut p = vec![0.0; dt.xt.len() / dt.d * dt.m];
         m.predict(&dt.xt, &mut p).unwrap();
         let e = rel(&p, &c.get("predictions").nums());
-        let ew = rel(m.ridge().weights(), &w_raw);
+        let ew = rel(m.ridge().unwrap().weights(), &w_raw);
         let mut b = vec![0.0; dt.m];
-        m.ridge().intercept(&mut b);
+        m.ridge().unwrap().intercept(&mut b);
         let eb = rel(&b, &b_raw);
         println!("normalize {name}: predictions {e:.1e}, weights {ew:.1e}, intercept {eb:.1e}");
         assert!(
