@@ -134,7 +134,7 @@ export const ORIGINAL_TYPES: ReadonlySet<string> = new Set([
  * Types the original's older example files use that no public source defines (neither the
  * original's library nor anything else published): there is nothing to load them as.
  */
-export const UNDEFINED_TYPES: ReadonlySet<string> = new Set(["FBGS", "hyperplaneFitting", "ddS"]);
+export const UNDEFINED_TYPES: ReadonlySet<string> = new Set(["FBGS", "hyperplaneFitting"]);
 
 /** Keys of the original's older files that we ignore, and why. */
 export const IGNORED_KEYS: Readonly<Record<string, string>> = {
