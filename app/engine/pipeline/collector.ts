@@ -9,6 +9,7 @@ import type { SourcePos } from "./spec";
 /** Collects the diagnostics of one file; positions come from node ranges and the line counter. */
 export class Collector {
   readonly list: Diagnostic[] = [];
+  private errorCount = 0;
   constructor(
     readonly file: string,
     readonly lc: LineCounter,
@@ -45,6 +46,7 @@ export class Collector {
       ...extra,
     };
     this.list.push(d);
+    if (severity === "error") this.errorCount++;
     return d;
   }
 
@@ -56,8 +58,9 @@ export class Collector {
     return this.add("warning", code, at, message, extra);
   }
 
+  /** Errors so far (counted as they come: stages ask after every block). */
   get errors(): number {
-    return this.list.filter((d) => d.severity === "error").length;
+    return this.errorCount;
   }
 }
 

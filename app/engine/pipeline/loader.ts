@@ -8,9 +8,21 @@
  *    and the `Pipeline:` settings;
  * 4. params (params.ts): zod, MOSAIC's positional form converted first (positional.ts);
  * 5. wiring (wiring.ts): inputs, ports and arity.
- * This file walks the top level and hands each block through the stages.
+ * This file walks the top level and hands each block through the stages. Every stage is linear
+ * in the size of the file, and what a file may hold is bounded (LOAD_LIMITS in spec.ts: size,
+ * blocks, values in Params, nesting): a refusal is one positioned error that names the limit.
  */
-import { isMap, isScalar, isSeq, type Node as YamlNode, type Pair, type YAMLMap } from "yaml";
+import {
+  isAlias,
+  isMap,
+  isScalar,
+  isSeq,
+  Pair,
+  YAMLMap,
+  YAMLSeq,
+  type Alias,
+  type Node as YamlNode,
+} from "yaml";
 import type { Catalog } from "../catalog";
 import { errorMessage } from "../diagnostics";
 import { Collector, describeNode, scalarString } from "./collector";
@@ -26,15 +38,62 @@ import { convertedWarning, paramKeyPositions, paramsText, readParams } from "./p
 import { lineCounterOf, parseStage } from "./parse";
 import { LegacyParamsError } from "./legacy";
 import { decimalCommaWarning, positionalArgs } from "./positional";
-import { BLOCK_NAME_RE, type BlockSpec, type LoadResult, type PipelineSettings } from "./spec";
+import {
+  BLOCK_NAME_RE,
+  LOAD_LIMITS,
+  type BlockSpec,
+  type LoadLimits,
+  type LoadResult,
+  type PipelineSettings,
+} from "./spec";
 import { checkWiring } from "./wiring";
 
 export * from "./spec";
 export { objectKeys } from "./params";
 
-export function loadPipeline(source: string, file: string, catalog: Catalog): LoadResult {
+/**
+ * Loads a pipeline file's text (`limits`: LOAD_LIMITS unless a caller raises or lowers them).
+ * Never throws on bad input: every problem is a positioned diagnostic.
+ */
+export function loadPipeline(
+  source: string,
+  file: string,
+  catalog: Catalog,
+  limits: LoadLimits = LOAD_LIMITS,
+): LoadResult {
+  if (source.length > limits.maxChars) {
+    const c = new Collector(file, lineCounterOf(""));
+    c.error(
+      "too-large",
+      { line: 1, col: 1 },
+      `the file has ${source.length} characters; a pipeline file may have at most ${limits.maxChars}`,
+      { expected: "a smaller file: large tables belong in data files (FilePlayer, model files)" },
+    );
+    return { spec: undefined, diagnostics: c.list, ok: false, doc: undefined };
+  }
   const c = new Collector(file, lineCounterOf(source));
-  const parsed = parseStage(c, source);
+  try {
+    return loadParsed(c, source, file, catalog, limits);
+  } catch (e) {
+    // A net under the limits: a structure deeper than the stack was not caught by them.
+    if (!(e instanceof RangeError)) throw e;
+    c.error(
+      "nesting-too-deep",
+      { line: 1, col: 1 },
+      `the pipeline nests or chains too deeply to load (${errorMessage(e)})`,
+    );
+    return { spec: undefined, diagnostics: c.list, ok: false, doc: undefined };
+  }
+}
+
+function loadParsed(
+  c: Collector,
+  source: string,
+  file: string,
+  catalog: Catalog,
+  limits: LoadLimits,
+): LoadResult {
+  const parsed = parseStage(c, source, limits);
   const doc = parsed.doc;
   if (!doc || !parsed.ok) return { spec: undefined, diagnostics: c.list, ok: false, doc };
   const root = doc.contents;
@@ -57,6 +116,8 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
   const settings: PipelineSettings = { batchingMs: undefined };
   const ignoredKeys: { block: string; pair: Pair }[] = [];
   const pendingRates: PendingRate[] = [];
+  let entries = 0;
+  let values = 0;
 
   for (const pair of (root as YAMLMap).items) {
     const keyNode = pair.key as YamlNode | null;
@@ -65,6 +126,15 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
     if (isSettingsEntry(name, pair.value)) {
       readSettings(c, pair.value as YAMLMap, settings);
       continue;
+    }
+    if (++entries > limits.maxBlocks) {
+      c.error(
+        "too-many-blocks",
+        at,
+        `the pipeline has more than ${limits.maxBlocks} blocks; this is block ${entries}`,
+        { expected: `at most ${limits.maxBlocks} blocks in one pipeline` },
+      );
+      break;
     }
     if (name === undefined || name === "") {
       c.error("bad-name", at, "a block name must be a plain word", {
@@ -104,6 +174,32 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
     const keys = readBlockKeys(c, name, at, value, catalog, view);
     const def = keys.def;
     if (!def) continue;
+
+    // Params with their aliases expanded (copies), within the limits on values.
+    const expanded = expandParams(keys.paramsNode, parsed.aliases, limits.maxParamsValues);
+    if (!expanded) {
+      c.error(
+        "too-many-values",
+        keys.paramsPos,
+        `block '${name}': Params hold more than ${limits.maxParamsValues} values (list items, keys and values, aliases expanded)`,
+        {
+          block: name,
+          expected: "large tables in a data file (FilePlayer, a model file) instead of in Params",
+        },
+      );
+      continue;
+    }
+    values += expanded.values;
+    if (values > limits.maxValues) {
+      c.error(
+        "too-many-values",
+        keys.paramsPos,
+        `the Params of the pipeline's blocks hold more than ${limits.maxValues} values in all (aliases expanded); this block's reach past it`,
+        { block: name },
+      );
+      break;
+    }
+    keys.paramsNode = expanded.node;
 
     // Stage 4: params, positional ones as the original's blocks read them.
     const written = isSeq(keys.paramsNode) ? positionalArgs(keys.paramsNode) : undefined;
@@ -213,4 +309,57 @@ export function loadPipeline(source: string, file: string, catalog: Catalog): Lo
 
 function isEmptyObject(v: unknown): boolean {
   return typeof v === "object" && v !== null && !Array.isArray(v) && Object.keys(v).length === 0;
+}
+
+/**
+ * A block's Params node with its aliases expanded into copies (the document itself is not
+ * changed: editors keep the file as written), and the values it holds; undefined when it holds
+ * more than `max`. Without aliases the node is returned as it is. Copies keep the ranges of what
+ * they copy, so errors point at the text an alias stands for.
+ */
+export function expandParams(
+  node: unknown,
+  aliases: ReadonlyMap<Alias, YamlNode>,
+  max: number,
+): { node: unknown; values: number } | undefined {
+  let values = 0;
+  let hasAlias = false;
+  const stack: unknown[] = [node];
+  while (stack.length > 0) {
+    const n = stack.pop();
+    if (n === null || n === undefined) continue;
+    if (isAlias(n)) {
+      hasAlias = true;
+      const target = aliases.get(n);
+      if (target) {
+        stack.push(target);
+        continue;
+      }
+    }
+    if (++values > max) return undefined;
+    if (isMap(n)) for (const p of n.items) stack.push(p.key, p.value);
+    else if (isSeq(n)) for (const it of n.items) stack.push(it);
+  }
+  if (!hasAlias) return { node, values };
+  // Recursion is bounded: the parse stage refused aliases that nest deeper than maxDepth.
+  const copy = (n: unknown): unknown => {
+    if (isAlias(n)) {
+      const target = aliases.get(n);
+      return target ? copy(target) : n;
+    }
+    if (isMap(n)) {
+      const m = new YAMLMap();
+      Object.assign(m, { range: n.range, flow: n.flow, tag: n.tag });
+      m.items = n.items.map((p) => new Pair(copy(p.key), copy(p.value)));
+      return m;
+    }
+    if (isSeq(n)) {
+      const s = new YAMLSeq();
+      Object.assign(s, { range: n.range, flow: n.flow, tag: n.tag });
+      s.items = n.items.map(copy);
+      return s;
+    }
+    return n;
+  };
+  return { node: copy(node), values };
 }

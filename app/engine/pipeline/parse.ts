@@ -6,27 +6,266 @@
  * multi-line flow collections the original MOSAIC accepted). The pre-pass keeps every offset, so
  * node ranges index the file as written and the editor (document.ts) edits it as it is. Files
  * that parse as they are never see the pre-pass.
+ *
+ * Linear in the size of the file, whatever it holds: lists and mappings nested deeper than
+ * `maxDepth` are refused from the parser's tokens, before the (recursive) composer sees them;
+ * duplicate keys are found with one set per mapping (the `yaml` option compares every key with
+ * every other); an alias standing for more values than a block's Params may hold (a "billion
+ * laughs") or nested too deep once expanded is refused at the alias, from sizes computed once per
+ * anchor, without expanding anything. The limits are spec.ts's LOAD_LIMITS.
  */
-import { LineCounter, parseDocument, type Document } from "yaml";
+import {
+  type Alias,
+  Composer,
+  Document,
+  isAlias,
+  isMap,
+  isScalar,
+  isSeq,
+  LineCounter,
+  Parser,
+  YAMLParseError,
+  type CST,
+  type ErrorCode,
+  type Node as YamlNode,
+} from "yaml";
 import { Collector } from "./collector";
-import type { SourcePos } from "./spec";
+import { LOAD_LIMITS, type LoadLimits, type SourcePos } from "./spec";
 import { relaxFlowLayout, type LayoutFix } from "./yaml-compat";
 
 export interface ParsedYaml {
   doc: Document;
   /** Fixes the pre-pass needed (none when the file parsed as it is). */
   fixes: LayoutFix[];
+  /**
+   * The node each alias stands for (the latest anchor of its name before it), so that stages
+   * expand aliases without `Alias.resolve`, which walks the whole document every time.
+   */
+  aliases: Map<Alias, YamlNode>;
 }
 
-const OPTIONS = { uniqueKeys: true, prettyErrors: false } as const;
+/** Keys are checked for duplicates here (checkNodes), in linear time. */
+const OPTIONS = { uniqueKeys: false, prettyErrors: false } as const;
+
+/** Error codes of this stage besides `yaml`'s own (they travel in `doc.errors`). */
+const TOO_DEEP = "NESTING_TOO_DEEP";
+const ALIAS_TOO_LARGE = "ALIAS_TOO_LARGE";
+const ALIAS_CYCLE = "ALIAS_CYCLE";
 
 /** Parses pipeline YAML the way the loader and the editor do (see the file comment). */
-export function parsePipelineYaml(source: string): ParsedYaml {
-  const doc = parseDocument(source, OPTIONS);
-  if (doc.errors.length === 0) return { doc, fixes: [] };
+export function parsePipelineYaml(
+  source: string,
+  limits: Pick<LoadLimits, "maxDepth" | "maxParamsValues"> = LOAD_LIMITS,
+): ParsedYaml {
+  const first = parseLimited(source, limits);
+  if (first.doc.errors.length === 0) return { ...first, fixes: [] };
   const relaxed = relaxFlowLayout(source);
-  if (relaxed.fixes.length === 0) return { doc, fixes: [] };
-  return { doc: parseDocument(relaxed.text, OPTIONS), fixes: relaxed.fixes };
+  if (relaxed.fixes.length === 0) return { ...first, fixes: [] };
+  return { ...parseLimited(relaxed.text, limits), fixes: relaxed.fixes };
+}
+
+/** `parseDocument` with the checks of the file comment. */
+function parseLimited(
+  source: string,
+  limits: Pick<LoadLimits, "maxDepth" | "maxParamsValues">,
+): { doc: Document; aliases: Map<Alias, YamlNode> } {
+  const tokens = Array.from(new Parser().parse(source));
+  const deep = tooDeep(tokens, limits.maxDepth);
+  if (deep !== undefined) {
+    const doc = new Document(null, OPTIONS);
+    doc.contents = null;
+    doc.errors.push(
+      new YAMLParseError(
+        [deep, deep + 1],
+        TOO_DEEP as ErrorCode,
+        `nesting too deep: lists and mappings more than ${limits.maxDepth} levels inside one another (a pipeline needs about 6)`,
+      ),
+    );
+    return { doc, aliases: new Map() };
+  }
+  // As `parseDocument` does.
+  const composer = new Composer(OPTIONS);
+  let doc: Document | undefined;
+  for (const d of composer.compose(tokens, true, source.length)) {
+    if (!doc) doc = d as Document;
+    else {
+      doc.errors.push(
+        new YAMLParseError(
+          d.range.slice(0, 2) as [number, number],
+          "MULTIPLE_DOCS",
+          "Source contains multiple documents; please use YAML.parseAllDocuments()",
+        ),
+      );
+      break;
+    }
+  }
+  const parsed = doc!;
+  const { errors, aliases } = checkNodes(parsed, limits);
+  if (errors.length > 0) {
+    parsed.errors.push(...errors);
+    parsed.errors.sort((a, b) => a.pos[0] - b.pos[0]);
+  }
+  return { doc: parsed, aliases };
+}
+
+/**
+ * The offset of the first list or mapping nested deeper than `max` in the parser's tokens, or
+ * undefined. Iterative: the tokens of a hostile file may nest a million levels.
+ */
+function tooDeep(tokens: readonly CST.Token[], max: number): number | undefined {
+  const stack: { t: CST.Token | null | undefined; depth: number }[] = [];
+  for (const t of tokens) stack.push({ t, depth: 0 });
+  while (stack.length > 0) {
+    const { t, depth } = stack.pop()!;
+    if (!t) continue;
+    switch (t.type) {
+      case "document":
+        stack.push({ t: t.value, depth });
+        break;
+      case "block-map":
+      case "block-seq":
+      case "flow-collection": {
+        if (depth + 1 > max) return t.offset;
+        for (const it of t.items as CST.CollectionItem[]) {
+          stack.push({ t: it.key, depth: depth + 1 });
+          stack.push({ t: it.value, depth: depth + 1 });
+        }
+        break;
+      }
+      default:
+        break;
+    }
+  }
+  return undefined;
+}
+
+interface Frame {
+  node: YamlNode;
+  children: (YamlNode | null)[];
+  i: number;
+  /** Values below this node (aliases expanded) and levels of lists and mappings. */
+  size: number;
+  height: number;
+}
+
+/**
+ * One pass over the composed nodes: duplicate keys (as `yaml`'s `uniqueKeys` defines them:
+ * scalars with the same value), and aliases that stand for too much (see the file comment).
+ */
+function checkNodes(
+  doc: Document,
+  limits: Pick<LoadLimits, "maxDepth" | "maxParamsValues">,
+): { errors: YAMLParseError[]; aliases: Map<Alias, YamlNode> } {
+  const errors: YAMLParseError[] = [];
+  const aliases = new Map<Alias, YamlNode>();
+  const root = doc.contents as YamlNode | null;
+  if (!root) return { errors, aliases };
+  /** The latest node that defined each anchor, and what it stands for once closed. */
+  const anchors = new Map<string, YamlNode>();
+  const measured = new Map<YamlNode, { size: number; height: number }>();
+  const open = new Set<YamlNode>();
+  const childrenOf = (node: YamlNode): (YamlNode | null)[] | undefined => {
+    if (isMap(node)) {
+      const out: (YamlNode | null)[] = [];
+      const seen = new Set<string>();
+      for (const p of node.items) {
+        const k = p.key as YamlNode | null;
+        const id = keyIdentity(k);
+        if (id !== undefined) {
+          if (seen.has(id)) {
+            const at = k?.range?.[0] ?? node.range?.[0] ?? 0;
+            errors.push(
+              new YAMLParseError([at, at + 1], "DUPLICATE_KEY", "Map keys must be unique"),
+            );
+          } else seen.add(id);
+        }
+        out.push(k, p.value as YamlNode | null);
+      }
+      return out;
+    }
+    if (isSeq(node)) return node.items as (YamlNode | null)[];
+    return undefined;
+  };
+  const aliasBudget = limits.maxParamsValues;
+  /** `depth`: lists and mappings around `node`. */
+  const enter = (node: YamlNode, depth: number): Frame | { size: number; height: number } => {
+    if (node.anchor !== undefined && node.anchor !== null) anchors.set(node.anchor, node);
+    if (isAlias(node)) {
+      const target = anchors.get(node.source);
+      const at = node.range?.[0] ?? 0;
+      if (!target) return { size: 1, height: 0 }; // `yaml` reports the unknown anchor
+      aliases.set(node, target);
+      if (open.has(target)) {
+        errors.push(
+          new YAMLParseError(
+            [at, at + 1],
+            ALIAS_CYCLE as ErrorCode,
+            `alias *${node.source} stands for a list or mapping that contains it`,
+          ),
+        );
+        return { size: 1, height: 0 };
+      }
+      const m = measured.get(target) ?? { size: 1, height: 0 };
+      if (m.size > aliasBudget || depth + m.height > limits.maxDepth) {
+        errors.push(
+          new YAMLParseError(
+            [at, at + 1],
+            (m.size > aliasBudget ? ALIAS_TOO_LARGE : TOO_DEEP) as ErrorCode,
+            m.size > aliasBudget
+              ? `alias *${node.source} stands for ${m.size >= 1e15 ? "too many" : m.size} values; an alias may stand for at most ${aliasBudget} (the values one block's Params may hold)`
+              : `nesting too deep: alias *${node.source} stands for lists and mappings ${m.height} levels deep, ${depth + m.height} levels here; at most ${limits.maxDepth}`,
+          ),
+        );
+        // Counted as one value from here on: one report per alias that is too large.
+        return { size: 1, height: 0 };
+      }
+      return m;
+    }
+    const children = childrenOf(node);
+    if (!children) {
+      if (node.anchor) measured.set(node, { size: 1, height: 0 });
+      return { size: 1, height: 0 };
+    }
+    open.add(node);
+    return { node, children, i: 0, size: 1, height: 1 };
+  };
+  const first = enter(root, 0);
+  if (!("children" in first)) return { errors, aliases };
+  const stack: Frame[] = [first];
+  while (stack.length > 0) {
+    const f = stack[stack.length - 1]!;
+    if (f.i < f.children.length) {
+      const child = f.children[f.i++];
+      if (!child) continue;
+      const r = enter(child, stack.length);
+      if ("children" in r) stack.push(r);
+      else {
+        f.size = Math.min(1e15, f.size + r.size);
+        f.height = Math.max(f.height, r.height + 1);
+      }
+      continue;
+    }
+    stack.pop();
+    open.delete(f.node);
+    if (f.node.anchor) measured.set(f.node, { size: f.size, height: f.height });
+    const parent = stack[stack.length - 1];
+    if (parent) {
+      parent.size = Math.min(1e15, parent.size + f.size);
+      parent.height = Math.max(parent.height, f.height + 1);
+    }
+  }
+  return { errors, aliases };
+}
+
+/** What makes two keys the same for `yaml`'s `uniqueKeys` (undefined: only itself). */
+function keyIdentity(k: YamlNode | null): string | undefined {
+  if (k === null) return "(no key)";
+  if (!isScalar(k)) return undefined;
+  const v = k.value;
+  if (v === null || v === undefined) return "null:";
+  if (typeof v === "number" && Number.isNaN(v)) return undefined;
+  if (typeof v === "object") return undefined;
+  return `${typeof v}:${String(v)}`;
 }
 
 /** A line counter over `source` (1-based lines and columns for offsets). */
@@ -40,28 +279,35 @@ export function lineCounterOf(source: string): LineCounter {
 export interface ParseStage {
   /** Undefined when the text could not be parsed at all. */
   doc: Document | undefined;
+  /** See ParsedYaml. */
+  aliases: Map<Alias, YamlNode>;
   /** False when the document has a syntax error (reported in `c`). */
   ok: boolean;
 }
 
 /** Stage 1: parses `source` and reports its first syntax error (the others are usually echoes). */
-export function parseStage(c: Collector, source: string): ParseStage {
+export function parseStage(
+  c: Collector,
+  source: string,
+  limits: Pick<LoadLimits, "maxDepth" | "maxParamsValues"> = LOAD_LIMITS,
+): ParseStage {
   let doc: Document;
+  let aliases: Map<Alias, YamlNode>;
   try {
-    doc = parsePipelineYaml(source).doc;
+    ({ doc, aliases } = parsePipelineYaml(source, limits));
   } catch (e) {
     c.error(
       "yaml-syntax",
       { line: 0, col: 0 },
       `cannot parse YAML: ${e instanceof Error ? e.message : String(e)}`,
     );
-    return { doc: undefined, ok: false };
+    return { doc: undefined, ok: false, aliases: new Map() };
   }
-  if (doc.errors.length === 0) return { doc, ok: true };
+  if (doc.errors.length === 0) return { doc, ok: true, aliases };
   const e = doc.errors[0]!;
   const d = syntaxDiagnostic(c, source, e.code, e.pos[0], e.message);
   c.error(d.code, d.at, d.message);
-  return { doc, ok: false };
+  return { doc, ok: false, aliases };
 }
 
 /** The diagnostic for one `yaml` error: its code, where it really is, and a readable message. */
@@ -75,7 +321,15 @@ export function syntaxDiagnostic(
   let p = c.at(offset);
   const first = message.split("\n")[0] ?? message;
   let msg = `YAML syntax error: ${first}`;
-  if (code === "DUPLICATE_KEY") {
+  if (code === TOO_DEEP) {
+    return { code: "nesting-too-deep", at: p, message: first };
+  } else if (code === ALIAS_TOO_LARGE || code === ALIAS_CYCLE) {
+    return { code: "alias-too-large", at: p, message: first };
+  } else if (/Maximum call stack size exceeded/.test(first)) {
+    // What the composer says when a structure is too deep for the stack (kept as a net: the
+    // depth limit refuses such files first).
+    return { code: "nesting-too-deep", at: p, message: "nesting too deep here" };
+  } else if (code === "DUPLICATE_KEY") {
     msg =
       "duplicate key: a block (or a key inside one) is defined twice; the second definition is here";
   } else if (code === "BLOCK_AS_IMPLICIT_KEY" || code === "MULTILINE_IMPLICIT_KEY") {

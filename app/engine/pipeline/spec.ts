@@ -68,6 +68,38 @@ export interface PipelineSpec {
   settings: PipelineSettings;
 }
 
+/**
+ * What the loader reads at most (README "Pipelines": limits). Every limit is far above what a
+ * pipeline needs and keeps loading fast and bounded in memory whatever a file (or a client of
+ * `mosaic serve`) sends: each refusal is one positioned error that names the limit.
+ */
+export interface LoadLimits {
+  /** Characters of the file. */
+  maxChars: number;
+  /** Blocks (top-level entries besides `Pipeline:`). */
+  maxBlocks: number;
+  /** Values (list items, mapping keys and values) in one block's Params, aliases expanded. */
+  maxParamsValues: number;
+  /** Values in all Params of the file together, aliases expanded. */
+  maxValues: number;
+  /** Lists and mappings inside one another (a pipeline needs about 6), aliases expanded. */
+  maxDepth: number;
+}
+
+/**
+ * The limits. Parsing costs about 1 KB of memory per value while the file's syntax tree is built
+ * (the `yaml` library's tokens), so 1 MB of the densest text (`0,0,0,…`) peaks near 500 MB; a
+ * 10 000-block file is about 0.7 MB and loads in well under a second; a 256 × 512 matrix fits in
+ * one block's Params.
+ */
+export const LOAD_LIMITS: Readonly<LoadLimits> = {
+  maxChars: 1_000_000,
+  maxBlocks: 10_000,
+  maxParamsValues: 1 << 17,
+  maxValues: 500_000,
+  maxDepth: 32,
+};
+
 export interface LoadResult {
   spec: PipelineSpec | undefined;
   diagnostics: Diagnostic[];

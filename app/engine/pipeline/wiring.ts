@@ -7,6 +7,9 @@ import { closest } from "../suggest";
 import type { Collector } from "./collector";
 import type { BlockSpec } from "./spec";
 
+const MAX_SUGGESTIONS = 100;
+const MAX_LISTED = 50;
+
 /**
  * Stage 5. `allNames`: every top-level name of the file, so that an input naming a block that
  * has its own error is not reported a second time.
@@ -17,12 +20,17 @@ export function checkWiring(
   byName: ReadonlyMap<string, BlockSpec>,
   allNames: readonly string[],
 ): void {
+  const named = new Set(allNames);
+  // Suggestions compare a name with every other: only for the first few (a file of thousands of
+  // dangling inputs stays linear), and the names are listed only when there are few.
+  let suggestions = 0;
   for (const b of blocks) {
     for (const inp of b.inputs) {
       const src = byName.get(inp.block);
       if (!src) {
-        if (allNames.includes(inp.block)) continue; // that block has its own error already
-        const suggestion = closest(inp.block, allNames);
+        if (named.has(inp.block)) continue; // that block has its own error already
+        const suggestion =
+          suggestions++ < MAX_SUGGESTIONS ? closest(inp.block, allNames) : undefined;
         c.error(
           "missing-input",
           inp.pos,
@@ -31,7 +39,12 @@ export function checkWiring(
             block: b.name,
             ...(suggestion !== undefined
               ? { suggestion }
-              : { expected: `one of ${allNames.join(", ")}` }),
+              : {
+                  expected:
+                    allNames.length <= MAX_LISTED
+                      ? `one of ${allNames.join(", ")}`
+                      : "the name of a block of this pipeline",
+                }),
           },
         );
         continue;

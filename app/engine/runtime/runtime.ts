@@ -310,31 +310,88 @@ export interface CreateResult {
   plan: Plan | undefined;
 }
 
+/**
+ * Blocks in topological order: at every step the first block in file order whose inputs are all
+ * placed, or, inside a feedback cycle, the first block in file order not placed yet. O((blocks +
+ * inputs) · log blocks): a heap of the ready blocks by file position.
+ */
 function topoOrder(spec: PipelineSpec): BlockSpec[] {
-  const indeg = new Map<string, number>();
-  const outs = new Map<string, string[]>();
-  for (const b of spec.blocks) {
-    indeg.set(b.name, 0);
-    outs.set(b.name, []);
-  }
-  for (const b of spec.blocks) {
+  const blocks = spec.blocks;
+  const index = new Map<string, number>();
+  blocks.forEach((b, i) => index.set(b.name, i));
+  const indeg = new Int32Array(blocks.length);
+  const outs: number[][] = blocks.map(() => []);
+  blocks.forEach((b, i) => {
     for (const inp of b.inputs) {
-      if (!indeg.has(inp.block) || inp.block === b.name) continue;
-      indeg.set(b.name, indeg.get(b.name)! + 1);
-      outs.get(inp.block)!.push(b.name);
+      const from = index.get(inp.block);
+      if (from === undefined || from === i) continue;
+      indeg[i]!++;
+      outs[from]!.push(i);
     }
-  }
+  });
+  const ready = new MinHeap();
+  for (let i = 0; i < blocks.length; i++) if (indeg[i] === 0) ready.push(i);
+  const done = new Uint8Array(blocks.length);
   const order: BlockSpec[] = [];
-  const done = new Set<string>();
-  while (order.length < spec.blocks.length) {
-    let next = spec.blocks.find((b) => !done.has(b.name) && indeg.get(b.name) === 0);
-    // Inside a feedback cycle: take the first remaining block in file order.
-    next ??= spec.blocks.find((b) => !done.has(b.name))!;
-    done.add(next.name);
-    order.push(next);
-    for (const o of outs.get(next.name)!) indeg.set(o, indeg.get(o)! - 1);
+  let firstLeft = 0;
+  while (order.length < blocks.length) {
+    let next = -1;
+    while (ready.size > 0) {
+      const i = ready.pop();
+      if (!done[i]) {
+        next = i;
+        break;
+      }
+    }
+    if (next < 0) {
+      // Inside a feedback cycle: take the first remaining block in file order.
+      while (done[firstLeft]) firstLeft++;
+      next = firstLeft;
+    }
+    done[next] = 1;
+    order.push(blocks[next]!);
+    for (const o of outs[next]!) if (--indeg[o]! === 0) ready.push(o);
   }
   return order;
+}
+
+/** A binary min-heap of numbers. */
+class MinHeap {
+  private readonly a: number[] = [];
+  get size(): number {
+    return this.a.length;
+  }
+  push(v: number): void {
+    const a = this.a;
+    let i = a.length;
+    a.push(v);
+    while (i > 0) {
+      const p = (i - 1) >> 1;
+      if (a[p]! <= v) break;
+      a[i] = a[p]!;
+      i = p;
+    }
+    a[i] = v;
+  }
+  pop(): number {
+    const a = this.a;
+    const top = a[0]!;
+    const last = a.pop()!;
+    if (a.length > 0) {
+      let i = 0;
+      for (;;) {
+        const l = 2 * i + 1;
+        if (l >= a.length) break;
+        const r = l + 1;
+        const c = r < a.length && a[r]! < a[l]! ? r : l;
+        if (a[c]! >= last) break;
+        a[i] = a[c]!;
+        i = c;
+      }
+      a[i] = last;
+    }
+    return top;
+  }
 }
 
 export class Runtime {
@@ -366,10 +423,12 @@ export class Runtime {
     opts: RuntimeOptions,
   ) {
     this.batchS = opts.batchingS ?? batchingOf(spec);
-    this.maxBatchS = Math.max(
-      this.batchS,
-      ...spec.blocks.map((b) => (b.batchingMs !== undefined ? b.batchingMs / 1000 : 0)),
-    );
+    // A loop, not Math.max(...all): a spread of 100k blocks overflows the stack.
+    let maxBatchS = this.batchS;
+    for (const b of spec.blocks) {
+      if (b.batchingMs !== undefined) maxBatchS = Math.max(maxBatchS, b.batchingMs / 1000);
+    }
+    this.maxBatchS = maxBatchS;
     this.worker = opts.worker ?? "main";
     this.clock = opts.clock;
     this.virtual = opts.virtual;
@@ -417,11 +476,12 @@ export class Runtime {
     const order = topoOrder(opts.spec);
     // Blocks on other workers are instantiated here only for planning (when no plan was given).
     const planning: Node[] = [];
+    const planningByName = new Map<string, Node>();
     for (const b of order) {
       const local = isLocal(b);
       if (!local && opts.plan) continue;
       const inputs: InputInfo[] = b.inputs.map((inp, index) => {
-        const src = rt.byName.get(inp.block) ?? planning.find((n) => n.name === inp.block);
+        const src = rt.byName.get(inp.block) ?? planningByName.get(inp.block);
         const ghost = ghosts.get(inp.block);
         const shape = src
           ? (src.ports.find((p) => p.name === inp.port)?.shape ?? null)
@@ -468,6 +528,7 @@ export class Runtime {
         rt.byName.set(b.name, node);
       } else {
         planning.push(node);
+        planningByName.set(b.name, node);
       }
     }
     if (diagnostics.length > 0) {
@@ -477,7 +538,7 @@ export class Runtime {
     // The plan, for workers that did not see the other blocks.
     const plan: Plan = opts.plan ?? {
       blocks: order.map((b) => {
-        const n = rt.byName.get(b.name) ?? planning.find((x) => x.name === b.name)!;
+        const n = rt.byName.get(b.name) ?? planningByName.get(b.name)!;
         return {
           name: b.name,
           type: b.type,
