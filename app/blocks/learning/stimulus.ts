@@ -21,6 +21,8 @@ export interface StimulusTriggers {
   readonly targetWidth: number;
   /** Calls `fn` with every trigger frame (borrowed: copy what you keep) before it is emitted. */
   onTrigger(fn: (f: Frame) => void): () => void;
+  /** Ends a capture phase in progress at time `t` (MOSAIC's TAC moved its Stimulus to fall). */
+  endCapture(t: number): void;
 }
 
 /** Most cues in one protocol (Tasks × Repetitions). */
@@ -316,6 +318,7 @@ export const Stimulus = defineBlock({
         triggerListeners.add(fn);
         return () => triggerListeners.delete(fn);
       },
+      endCapture: (t: number) => endCapture(t),
     } satisfies StimulusTriggers);
     const flushTrigger = (): void => {
       if (trigN === 0) return;
@@ -365,6 +368,14 @@ export const Stimulus = defineBlock({
       phaseStart = at;
       phaseEnd = phase === END ? Infinity : at + dur[phase]!;
       throttle.reset();
+    };
+
+    /** Ends the current capture phase at `t` (the skip input, a TAC's success). */
+    const endCapture = (t: number): void => {
+      if (state !== "running" || phase !== CAPTURE) return;
+      advance(Math.max(t, phaseStart), t);
+      flushTrigger();
+      describe(t);
     };
 
     const begin = (): void => {
@@ -470,11 +481,7 @@ export const Stimulus = defineBlock({
           return;
         }
         // Skip input: any event ends the current capture phase at its time.
-        if (state !== "running" || phase !== CAPTURE || f.n === 0) return;
-        const t = f.t[0]!;
-        advance(Math.max(t, phaseStart), t);
-        flushTrigger();
-        describe(t);
+        if (f.n > 0) endCapture(f.t[0]!);
       },
       dispose() {
         withdraw();

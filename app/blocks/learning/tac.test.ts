@@ -424,6 +424,7 @@ describe("TAC in a pipeline", () => {
       "increm_learning_TAC",
     );
     expect(p).toEqual({
+      Stimulus: "TAC_stim",
       Dwell: 2,
       Tolerance: 0.2,
       TimeLimit: Infinity,
@@ -474,5 +475,30 @@ describe("TAC in a pipeline", () => {
       Capture: 20,
       Tasks: [{ Label: "task1" }, { Label: "task2" }],
     });
+  });
+
+  test("MOSAIC's form: the named Stimulus's captures are the trials, and a success ends the capture", async () => {
+    // cfg7's wiring: the target input is the cue shown (a Selector of the Stimulus); the control
+    // follows the cue exactly, so each capture succeeds after the dwell (2 s), not after 20 s.
+    const yaml =
+      "timer_subs: { Type: ScheduledTimer, DesiredRate: 25 }\n" +
+      "TAC_stim: { Type: Stimulus, Inputs: [ -timer_subs ], Params: { Capture: 20, Autostart: true, Tasks: [ { Label: a, Target: [0.8, 0] }, { Label: b, Target: [0, 0.8] } ] } }\n" +
+      "TAC_stim_tv: { Type: Selector, Inputs: [ TAC_stim ] }\n" +
+      "tac: { Type: TAC, Inputs: [ TAC_stim_tv, TAC_stim_tv ], Params: [ TAC_stim, 2.0, 0.2 ] }\n";
+    const r = await runVirtualPipeline(yaml, {
+      catalog: withCursor,
+      duration: 20,
+      start: 100,
+      record: ["tac", "TAC_stim"],
+    });
+    const trials = r.outputs.get("tac")!;
+    // [index, success, completion time, efficiency, final distance]
+    expect(trials.v.map((v) => v.slice(0, 3))).toEqual([
+      [0, 1, 2],
+      [1, 1, 2],
+    ]);
+    // Rest 2, rise 1, hold 2, capture (ended by the success after 2 s), fall 1: the second
+    // capture starts 8 s after the first.
+    expect(trials.t.map((t) => Math.round((t - 100) * 100) / 100)).toEqual([7, 15]);
   });
 });

@@ -10,6 +10,8 @@ import { vectorInput, inputName } from "../shared/inputs";
 import { extendedNumber } from "../shared/params";
 import { SeededRandom } from "../shared/random";
 import { plural, TextThrottle } from "../shared/text";
+import { lookup } from "../shared/named";
+import type { StimulusTriggers } from "./stimulus";
 import { seconds } from "./trigger";
 
 /** Most trials, and most target values (trials × DoFs) a TAC keeps. */
@@ -93,6 +95,15 @@ const params = z.strictObject({
     .boolean()
     .default(false)
     .describe("Start the test when the pipeline starts (otherwise: the start action)"),
+  Stimulus: z
+    .string()
+    .min(1)
+    .optional()
+    .describe(
+      "MOSAIC's form: the Stimulus whose capture phases are the trials, read by name (on the " +
+        "same worker): a trial starts with a capture and ends with it, and a success ends the " +
+        "capture (the Stimulus moves on to fall); the target input then only feeds displays",
+    ),
 });
 
 type Params = z.output<typeof params>;
@@ -132,8 +143,9 @@ export const TAC = defineBlock({
     "`stop` (the trial in progress is dropped), `summary`. The status shows the trial and the " +
     "time inside; when finished, the success rate, mean completion time and mean path " +
     "efficiency (over successful trials). MOSAIC's `[stimulusBlock, dwell, tolerance]` loads " +
-    "with Order target-control and Autostart; MOSAIC's TAC read the Stimulus's state by name, " +
-    "which blocks cannot do here: feed its target input from the Stimulus's `trigger` port.",
+    "with Order target-control, Autostart and `Stimulus`: as MOSAIC's TAC, it reads the named " +
+    "Stimulus's capture phases (trials are the captures, a success ends the capture), whatever " +
+    "its target input carries (MOSAIC's files wire the cue shown, a Selector of the Stimulus).",
   params,
   legacyParams: (args) => {
     if (args.length !== 3) {
@@ -142,6 +154,7 @@ export const TAC = defineBlock({
       );
     }
     return {
+      Stimulus: args[0]!.trim(),
       Dwell: legacyNumber(args[1]!, "the dwell time", "Dwell"),
       Tolerance: legacyNumber(args[2]!, "the tolerance", "Tolerance"),
       TimeLimit: Infinity,
@@ -150,7 +163,7 @@ export const TAC = defineBlock({
     };
   },
   legacyForm:
-    "[stimulusBlock, dwellSeconds, tolerance] (the block name is not used: wire the Stimulus's trigger port as the target input)",
+    "[stimulusBlock, dwellSeconds, tolerance]: the Stimulus whose captures are the trials (read by name), the dwell and the tolerance",
   inputs: { min: 1, max: 2, labels: ["control", "target"] },
   outputs: ["trial", "target"],
   live: ["Tolerance", "Dwell", "TimeLimit", "Pause"],
@@ -181,7 +194,7 @@ export const TAC = defineBlock({
         "Targets",
       );
     }
-    if (targetIn === null && p.Targets === undefined) {
+    if (targetIn === null && p.Targets === undefined && p.Stimulus === undefined) {
       throw new BlockConfigError(
         "give Targets (a list of target vectors or { Random: { Count } }) or a second input with targets",
         "Targets",
@@ -375,12 +388,14 @@ export const TAC = defineBlock({
       k++;
       nextStart = time + pause;
       throttle.reset();
+      // MOSAIC's TAC moved its Stimulus on to fall when the target was reached.
+      if (success) stim?.endCapture(time);
     };
 
     /** One control event at `time` with the position in `pos`. */
     const step = (time: number): void => {
       if (!inTrial) {
-        if (targetIn === null) {
+        if (targetIn === null && p.Stimulus === undefined) {
           if (k >= total || time < nextStart) return;
           goal.set(list[k]!);
           beginTrial(time, pos);
@@ -438,6 +453,31 @@ export const TAC = defineBlock({
       }
     };
 
+    // MOSAIC's form: the named Stimulus's capture phases are the trials.
+    let stim: StimulusTriggers | undefined;
+    let unlisten: (() => void) | undefined;
+    const listen = (): void => {
+      if (p.Stimulus === undefined || unlisten) return;
+      const s = lookup<StimulusTriggers>(ctx, p.Stimulus, "Stimulus");
+      if (typeof s === "string") {
+        ctx.warn(`Stimulus '${p.Stimulus}': ${s}; trials follow the target input instead`);
+        return;
+      }
+      if (s.targetWidth !== D) {
+        ctx.warn(
+          `Stimulus '${p.Stimulus}' has targets of ${s.targetWidth} values, the control ${D}: ` +
+            "trials follow the target input instead",
+        );
+        return;
+      }
+      stim = s;
+      unlisten = s.onTrigger((f) => {
+        if (!running) return;
+        for (let e = 0; e < f.n; e++) onTarget(f.t[e]!, f.v, e * D);
+        describe(f.t[f.n - 1]!);
+      });
+    };
+
     const begin = (): void => {
       running = true;
       trials = successes = 0;
@@ -462,6 +502,7 @@ export const TAC = defineBlock({
     return {
       start() {
         started = true;
+        listen();
         if (p.Autostart) begin();
         describe(ctx.now());
       },
@@ -472,7 +513,8 @@ export const TAC = defineBlock({
         const n = f.n;
         if (n === 0) return;
         if (port === ti) {
-          if (!running) return;
+          // Trials come from the named Stimulus: the target input only feeds displays.
+          if (!running || stim !== undefined) return;
           for (let e = 0; e < n; e++) onTarget(f.t[e]!, f.v, e * D);
           describe(f.t[n - 1]!);
           return;
@@ -505,6 +547,11 @@ export const TAC = defineBlock({
         lastTarget.fill(NaN);
         if (started && p.Autostart) begin();
         describe(ctx.now());
+      },
+      dispose() {
+        unlisten?.();
+        unlisten = undefined;
+        stim = undefined;
       },
       setParam(name, value) {
         if (name === "Tolerance")
