@@ -129,6 +129,20 @@ export interface BlockContext {
   /** A warning shown in the block's status (and printed by the CLI), rate-limited. */
   warn(message: string): void;
   /**
+   * Reports an error that happened outside `process` (a failed sidecar call, a crashed helper
+   * process): counted like an exception thrown by `process` (the block's `errors`, `lastError`,
+   * an error event, rate-limited; `mosaic run` exits 1). `detail` (a traceback) goes with the
+   * event only.
+   */
+  error(message: string, detail?: string): void;
+  /**
+   * How many results this block still waits for from outside the engine (calls in flight in a
+   * sidecar, inputs queued for them); 0 when none. Under the virtual clock, time does not advance
+   * while any block waits, so a replay does not depend on how fast the outside answers; real time
+   * ignores it.
+   */
+  setAwaiting(count: number): void;
+  /**
    * Reports work done for this block outside `process`, e.g. a call in the Python sidecar that
    * `process` only handed over: `ms` joins the block's compute max (not its CPU total), and a call
    * longer than `budgetMs` (default one period, 1 / DesiredRate) marks the block stumbling, as a

@@ -144,6 +144,10 @@ export class BlockHarness {
   oneShot: { t: number; fn: (t: number) => void } | null = null;
   text = "";
   warnings: string[] = [];
+  /** What the block reported through `ctx.error` (message, and detail when given). */
+  errors: string[] = [];
+  /** The last count the block gave `ctx.setAwaiting`. */
+  awaiting = 0;
   /** What the block reported through `ctx.reportCompute`. */
   computeReports: { ms: number; budgetMs?: number }[] = [];
   readonly logs = new MemoryLogSink();
@@ -265,6 +269,12 @@ export class BlockHarness {
       },
       warn(message: string) {
         h.warnings.push(message);
+      },
+      error(message: string, detail?: string) {
+        h.errors.push(detail ? `${message}\n${detail}` : message);
+      },
+      setAwaiting(count: number) {
+        h.awaiting = count;
       },
       reportCompute(ms: number, budgetMs?: number) {
         h.computeReports.push({ ms, ...(budgetMs === undefined ? {} : { budgetMs }) });

@@ -176,7 +176,13 @@ function start(): void {
         post({ type: "telemetry", report: report(runtime.telemetry()) });
       }
       if (r === "yield") setImmediate(chunk);
-      else post({ type: "finished", telemetry: runtime.telemetry() });
+      else if (r === "waiting") {
+        // A block waits for results from outside (Python calls): go on when they are in.
+        runtime.onWake = () => {
+          runtime.onWake = null;
+          setImmediate(chunk);
+        };
+      } else post({ type: "finished", telemetry: runtime.telemetry() });
     };
     setImmediate(chunk);
     return;

@@ -267,6 +267,8 @@ class Node {
   errors = 0;
   lastError = "";
   lastWarnAt = -Infinity;
+  /** Results this block waits for from outside the engine (`ctx.setAwaiting`). */
+  awaiting = 0;
   finished = false;
   finite = false;
   readonly extraLogs: LogChannel[] = [];
@@ -706,6 +708,12 @@ export class Runtime {
       warn(message: string) {
         rt.warn(node, message);
       },
+      error(message: string, detail?: string) {
+        rt.fail(node, message, detail);
+      },
+      setAwaiting(count: number) {
+        rt.setAwaiting(node, count);
+      },
       reportCompute(ms: number, budgetMs?: number) {
         node.status.external(ms, rt.clock.now(), budgetMs);
       },
@@ -945,7 +953,7 @@ export class Runtime {
     return this.finiteCount > 0 && this.finishedCount >= this.finiteCount;
   }
 
-  private fail(node: Node, err: unknown): void {
+  private fail(node: Node, err: unknown, detail?: string): void {
     node.errors++;
     node.lastError = errorMessage(err);
     const now = this.clock.now();
@@ -955,9 +963,21 @@ export class Runtime {
         t: now,
         level: "error",
         block: node.name,
-        message: `${node.lastError}${node.errors > 1 ? ` (${node.errors} errors so far)` : ""}`,
+        message: `${node.lastError}${node.errors > 1 ? ` (${node.errors} errors so far)` : ""}${detail ? `\n${detail}` : ""}`,
       });
     }
+  }
+
+  /** Results all blocks of this worker wait for from outside the engine (`ctx.setAwaiting`). */
+  awaiting = 0;
+
+  private setAwaiting(node: Node, count: number): void {
+    const n = count > 0 ? count : 0;
+    if (n === node.awaiting) return;
+    this.awaiting += n - node.awaiting;
+    node.awaiting = n;
+    // The last awaited result arrived from an I/O callback: the virtual driver goes on.
+    if (this.awaiting === 0 && !this.stepping) this.onWake?.();
   }
 
   private warn(node: Node, message: string): void {
@@ -997,7 +1017,9 @@ export class Runtime {
         this.fail(n, err);
       }
       n.started = false;
+      n.awaiting = 0;
     }
+    this.awaiting = 0;
   }
 
   dispose(): void {
