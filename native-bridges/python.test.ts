@@ -3,8 +3,8 @@
  * and real sidecar processes (the uv environment's interpreter, started directly for speed):
  * load, calls in order, errors, restart after kill -9 with backoff, clean close, start failures.
  */
-import { existsSync, mkdtempSync, writeFileSync } from "node:fs";
-import { tmpdir } from "node:os";
+import { existsSync, mkdtempSync, readFileSync, writeFileSync } from "node:fs";
+import { getPriority, tmpdir } from "node:os";
 import { join } from "node:path";
 import { describe, expect, test } from "vitest";
 import type { PythonCallError, PythonLoadOptions, PythonSidecarState } from "../app/engine/io";
@@ -16,7 +16,11 @@ import {
   MessageReader,
   MSG,
   PythonLoadError,
+  SIDECAR_NICE,
 } from "./python";
+
+/** This process's nice value. */
+const osPriorityNice = (): number => getPriority();
 
 const ROOT = join(import.meta.dirname, "..");
 const PROJECT = join(ROOT, "native-bridges", "python");
@@ -213,6 +217,109 @@ describe.skipIf(!haveVenv)("real sidecar processes", () => {
       kind: "missing-function",
       message: expect.stringMatching(/has no function 'g' \(it defines: f, init\)/),
     });
+  });
+
+  test("hard limit: a hung call is reported late, then its process is killed and restarted", async () => {
+    writeFileSync(
+      join(dir, "hang.py"),
+      "import time\ndef f(x):\n    if x[0, 0] < 0:\n        time.sleep(1e6)\n    return x\n",
+    );
+    const late: number[] = [];
+    const [o, rec] = options(dir, {
+      module: "hang.py",
+      hardLimitMs: 400,
+      lateAfterMs: 50,
+      onLate: (_id, ms) => late.push(ms),
+    });
+    const sc = await direct.load(o);
+    const first = sc.pid!;
+    const hung = sc.call(new Float64Array([-1, 0, 0]));
+    const behind = sc.call(new Float64Array([1, 0, 0]));
+    await until(() => rec.states.some(([s]) => s === "restarting"));
+    expect(late.length).toBeGreaterThan(2);
+    expect(late.every((ms) => ms > 50 && ms <= 700)).toBe(true);
+    expect(rec.errors.map((e) => [e.id, e.e.kind])).toEqual([
+      [hung, "timeout"],
+      [behind, "crash"],
+    ]);
+    expect(rec.errors[0]!.e.message).toMatch(/call ran longer than its hard limit of 0\.4 s/);
+    expect(rec.states.find(([s]) => s === "restarting")![1]).toMatch(
+      new RegExp(
+        `^a call ran longer than its hard limit of 0\\.4 s \\(HardLimit\\): the Python process \\(pid ${first}\\) was killed; restarting in 0\\.1 s$`,
+      ),
+    );
+    await until(() => !alive(first));
+    await until(() => sc.ready);
+    expect(sc.pid).not.toBe(first);
+    sc.call(new Float64Array([2, 0, 0]));
+    await until(() => rec.results.length === 1);
+    sc.close();
+  });
+
+  test("a slow init on reset does not count against the calls that wait behind it", async () => {
+    // init runs twice at load (the probe's state, then the real one), then sleeps on reset.
+    writeFileSync(
+      join(dir, "slowinit.py"),
+      "import time\nn = [0]\ndef init(p):\n    n[0] += 1\n    if n[0] > 2:\n        time.sleep(0.6)\n    return 0\ndef f(x, s):\n    return x\n",
+    );
+    const [o, rec] = options(dir, { module: "slowinit.py", init: "init", hardLimitMs: 300 });
+    const sc = await direct.load(o);
+    sc.reset(); // init sleeps 0.6 s: longer than the hard limit
+    sc.call(new Float64Array([1, 0, 0]));
+    await until(() => rec.results.length === 1);
+    expect(rec.states.some(([s]) => s === "restarting")).toBe(false);
+    sc.close();
+  });
+
+  test("close() ends a process stuck in a call at once", async () => {
+    const [o] = options(dir, { module: "hang.py" });
+    const sc = await direct.load(o);
+    const pid = sc.pid!;
+    sc.call(new Float64Array([-1, 0, 0]));
+    await new Promise((r) => setTimeout(r, 200));
+    const t0 = Date.now();
+    sc.close();
+    await until(() => !alive(pid), 3000);
+    expect(Date.now() - t0).toBeLessThan(1500);
+  });
+
+  test("the sidecar runs niced, with its memory limited; a MemoryError says which limit", async () => {
+    writeFileSync(
+      join(dir, "mem.py"),
+      "import numpy as np\ndef f(x):\n    return x + np.empty(int(x[0, 0]) * 131072)[:1].size * 0\n",
+    );
+    const [o, rec] = options(dir, { module: "mem.py", memoryLimitMb: 250 });
+    const sc = await direct.load(o);
+    const stat = readFileSync(`/proc/${sc.pid!}/stat`, "utf8");
+    const nice = Number(stat.slice(stat.lastIndexOf(")") + 2).split(" ")[16]);
+    expect(nice).toBe(Math.min(19, osPriorityNice() + SIDECAR_NICE));
+    sc.call(new Float64Array([300, 0, 0]));
+    sc.call(new Float64Array([10, 0, 0]));
+    await until(() => rec.errors.length + rec.results.length === 2);
+    expect(rec.errors[0]!.e.kind).toBe("memory");
+    expect(rec.errors[0]!.e.message).toMatch(
+      /^MemoryError: .* the sidecar's memory limit \(MemoryLimit: 250 MB\) was reached/,
+    );
+    expect(rec.results.map((r) => r.values[0])).toEqual([10]);
+    sc.close();
+  });
+
+  test("the default command starts the uv environment's interpreter as the host's own child", async () => {
+    const bridge = createPythonBridge();
+    const [o, rec] = options(dir, { init: "init" });
+    const sc = await bridge.load(o);
+    const pid = sc.pid!;
+    const stat = readFileSync(`/proc/${pid}/stat`, "utf8");
+    const ppid = Number(stat.slice(stat.lastIndexOf(")") + 2).split(" ")[1]);
+    expect(ppid).toBe(process.pid);
+    expect(readFileSync(`/proc/${pid}/cmdline`, "utf8").split("\0").slice(1, 3)).toEqual([
+      "-m",
+      "mosaic_sidecar",
+    ]);
+    sc.call(new Float64Array([1, 2, 3]));
+    await until(() => rec.results.length === 1);
+    sc.close();
+    await until(() => !alive(pid));
   });
 
   test("a sidecar that cannot start says why", async () => {

@@ -1,17 +1,23 @@
 /**
  * The Python sidecar bridge for Node hosts (`ctx.io.python`). Every Python block gets its own
- * process (`python -m mosaic_sidecar` in the uv environment of native-bridges/python, started with
- * `python3 -m uv run --frozen …`, never downloading an interpreter), so one slow or crashing block
- * never stalls another, and the engine never waits on any of them: `call` writes one framed message
- * to the process's stdin and returns; the result arrives on the worker's event loop. A process that
- * dies (a crash, `kill -9`, an out-of-memory kill) is reported and started again with backoff
- * (0.5 s doubling to 10 s), its module loaded again with a fresh state. The wire format is in
- * docs/protocols.md ("Python sidecar") and native-bridges/python/mosaic_sidecar/protocol.py.
+ * process (`python -m mosaic_sidecar` with the interpreter of the uv environment of
+ * native-bridges/python, found once per host process with `python3 -m uv run --frozen …`, never
+ * downloading an interpreter, and then started directly, so that signals reach it and it is the
+ * host's own child), so one slow or crashing block never stalls another, and the engine never
+ * waits on any of them: `call` writes one framed message to the process's stdin and returns; the
+ * result arrives on the worker's event loop. A process that dies (a crash, `kill -9`, an
+ * out-of-memory kill) is reported and started again with backoff (0.5 s doubling to 10 s), its
+ * module loaded again with a fresh state; so is one whose call passes the hard limit
+ * (`hardLimitMs`: it is killed first). The process runs niced (`nice`, default +10) with its data
+ * memory limited (`memoryLimitMb`), and never outlives the host: it ends itself when its stdin's
+ * write end closes (the host stopped it, or died), and on Linux the kernel kills it with its
+ * parent (PR_SET_PDEATHSIG; see mosaic_sidecar/server.py). The wire format is in docs/protocols.md
+ * ("Python sidecar") and native-bridges/python/mosaic_sidecar/protocol.py.
  *
  * `MOSAIC_PYTHON=/path/to/python` runs that interpreter instead of the uv environment (it needs
  * NumPy, and whatever the user's modules import).
  */
-import { spawn, type ChildProcess } from "node:child_process";
+import { execFile, spawn, type ChildProcess } from "node:child_process";
 import { existsSync } from "node:fs";
 import { delimiter, dirname, join } from "node:path";
 import { fileURLToPath } from "node:url";
@@ -36,6 +42,10 @@ export const MSG = {
   shutdown: 8,
 } as const;
 const MAX_PAYLOAD = 1 << 30;
+/** How much lower than the host's the sidecar's scheduling priority is (a nice increment). */
+export const SIDECAR_NICE = 10;
+/** The sidecar's exit status after running out of memory outside the user's function. */
+const EXIT_OUT_OF_MEMORY = 3;
 
 /** A load failure; `kind` says which param is at fault (missing-module, syntax, shape, …). */
 export class PythonLoadError extends Error {
@@ -153,8 +163,10 @@ export interface SidecarCommand {
 export interface PythonBridgeOptions {
   /** The repository root (holds native-bridges/python); found from this file by default. */
   root?: string;
-  /** How to start a sidecar (tests); default: uv run in native-bridges/python. */
-  command?: (cwd: string) => SidecarCommand;
+  /** How to start a sidecar (tests); default: the interpreter of native-bridges/python's uv environment. */
+  command?: (cwd: string) => SidecarCommand | Promise<SidecarCommand>;
+  /** The sidecar's nice increment over the host (default SIDECAR_NICE; 0 keeps the host's). */
+  nice?: number;
   /** First restart delay and its cap (ms). */
   backoffMs?: { first: number; max: number };
   /** How long a start (hello + load, imports included) may take. */
@@ -170,30 +182,68 @@ function repoRoot(): string {
   return process.cwd();
 }
 
-/** The default command: the uv environment of native-bridges/python (or `MOSAIC_PYTHON`). */
-export function defaultCommand(root: string): (cwd: string) => SidecarCommand {
+const uvRun = (project: string): string[] => [
+  "-m",
+  "uv",
+  "run",
+  "--quiet",
+  "--frozen",
+  "--project",
+  project,
+  "--python",
+  "python3.11",
+  "python",
+];
+
+/** The uv environment's interpreter, per project, found once per host process. */
+const interpreters = new Map<string, Promise<string | undefined>>();
+
+/**
+ * The interpreter of `project`'s uv environment (`uv run` syncs it if needed, never downloading
+ * Python); undefined when uv cannot run it (then the sidecar is started through `uv run` and its
+ * failure says why).
+ */
+function uvInterpreter(project: string): Promise<string | undefined> {
+  let found = interpreters.get(project);
+  if (!found) {
+    found = new Promise((resolve) => {
+      execFile(
+        process.env.MOSAIC_PYTHON3 ?? "python3",
+        [...uvRun(project), "-c", "import sys; print(sys.executable)"],
+        { env: { ...process.env, UV_PYTHON_DOWNLOADS: "never" }, timeout: 120_000 },
+        (err, stdout) => {
+          const exe = String(stdout).trim().split("\n").at(-1);
+          const ok = !err && exe !== undefined && exe !== "" && existsSync(exe);
+          if (!ok) interpreters.delete(project);
+          resolve(ok ? exe : undefined);
+        },
+      );
+    });
+    interpreters.set(project, found);
+  }
+  return found;
+}
+
+/**
+ * The default command: the interpreter of native-bridges/python's uv environment (or
+ * `MOSAIC_PYTHON`), started directly so that the sidecar is the host's own child (signals reach
+ * it; the kernel kills it with its parent); `uv run` itself when that interpreter cannot be found.
+ */
+export function defaultCommand(root: string): (cwd: string) => Promise<SidecarCommand> {
   const project = join(root, "native-bridges", "python");
-  return (cwd) => {
+  return async (cwd) => {
     const pythonPath = [project, cwd, process.env.PYTHONPATH].filter(Boolean).join(delimiter);
-    const env = { PYTHONPATH: pythonPath, PYTHONUNBUFFERED: "1", UV_PYTHON_DOWNLOADS: "never" };
-    const own = process.env.MOSAIC_PYTHON;
+    const env = {
+      PYTHONPATH: pythonPath,
+      PYTHONUNBUFFERED: "1",
+      UV_PYTHON_DOWNLOADS: "never",
+      MOSAIC_PARENT_PID: String(process.pid),
+    };
+    const own = process.env.MOSAIC_PYTHON ?? (await uvInterpreter(project));
     if (own) return { file: own, args: ["-m", "mosaic_sidecar"], env };
     return {
       file: process.env.MOSAIC_PYTHON3 ?? "python3",
-      args: [
-        "-m",
-        "uv",
-        "run",
-        "--quiet",
-        "--frozen",
-        "--project",
-        project,
-        "--python",
-        "python3.11",
-        "python",
-        "-m",
-        "mosaic_sidecar",
-      ],
+      args: [...uvRun(project), "-m", "mosaic_sidecar"],
       env,
     };
   };
@@ -212,6 +262,8 @@ class Proc {
   private partialLine = "";
   exited = false;
   exitReason = "";
+  /** Why the host killed it (the hard limit), said before the exit reason. */
+  cause = "";
   pid: number | undefined;
 
   constructor(
@@ -256,7 +308,13 @@ class Proc {
     this.child.stdin!.on("error", () => {}); // EPIPE after a crash: the exit event reports it
     this.child.on("error", (e) => this.finish(`cannot start ${cmd.file}: ${e.message}`));
     this.child.on("exit", (code, signal) =>
-      this.finish(signal ? `killed by ${signal}` : `exited with code ${code}`),
+      this.finish(
+        signal
+          ? `killed by ${signal}`
+          : code === EXIT_OUT_OF_MEMORY
+            ? `ran out of memory (exit code ${code}): ${this.stderr(1).replace(/^mosaic_sidecar: out of memory; /, "")}`
+            : `exited with code ${code}`,
+      ),
     );
   }
 
@@ -307,11 +365,21 @@ class Proc {
   }
 
   kill(): void {
+    if (this.exited) return;
+    // With `uv run` (or another launcher) between us, the interpreter is another process.
+    if (this.pid !== undefined && this.pid !== this.child.pid) {
+      try {
+        process.kill(this.pid, "SIGKILL");
+      } catch {
+        // gone
+      }
+    }
     try {
       this.child.kill("SIGKILL");
     } catch {
       // gone
     }
+    this.child.stdin?.destroy();
   }
 }
 
@@ -330,16 +398,18 @@ export function createPythonBridge(options: PythonBridgeOptions = {}): PythonBri
   const command = options.command ?? defaultCommand(root);
   const backoff = options.backoffMs ?? { first: 500, max: 10_000 };
   const loadTimeoutMs = options.loadTimeoutMs ?? 120_000;
+  const nice = options.nice ?? SIDECAR_NICE;
   return {
-    load: (o) => startSidecar(o, command, backoff, loadTimeoutMs),
+    load: (o) => startSidecar(o, command, backoff, loadTimeoutMs, nice),
   };
 }
 
 async function startSidecar(
   o: PythonLoadOptions,
-  command: (cwd: string) => SidecarCommand,
+  command: (cwd: string) => SidecarCommand | Promise<SidecarCommand>,
   backoff: { first: number; max: number },
   loadTimeoutMs: number,
+  nice: number,
 ): Promise<PythonSidecar> {
   const cwd = o.cwd ?? process.cwd();
   let nextId = 1;
@@ -357,13 +427,28 @@ async function startSidecar(
   let out = new Float64Array(1);
   /** Calls sent to the current process and not answered yet, oldest first. */
   const inFlight: number[] = [];
+  /** Since when the oldest call in flight is the one the process works on (ms). */
+  let headSince = 0;
   let delay = backoff.first;
   let readySince = 0;
   let retry: ReturnType<typeof setTimeout> | undefined;
+  const hardLimitMs = o.hardLimitMs !== undefined && o.hardLimitMs > 0 ? o.hardLimitMs : Infinity;
+  /** The call that passed the hard limit (its process is being killed). */
+  let timedOut = -1;
+  /**
+   * One entry per `reset` not answered yet: how many calls in flight are still ahead of it.
+   * `init` may take long (training); the calls behind it wait and their time does not run.
+   */
+  const resets: number[] = [];
+  let watchdog: ReturnType<typeof setInterval> | undefined;
 
   const onCall = (type: number, callId: number, payload: Buffer): void => {
     const k = inFlight.indexOf(callId);
-    if (k >= 0) inFlight.splice(k, 1);
+    if (k >= 0) {
+      inFlight.splice(k, 1);
+      if (k === 0) headSince = performance.now();
+      for (let i = 0; i < resets.length; i++) if (resets[i]! > 0) resets[i]!--;
+    }
     if (closed) return;
     if (type === MSG.result) {
       const us = payload.length >= 8 ? payload.readDoubleLE(0) : NaN;
@@ -389,9 +474,28 @@ async function startSidecar(
     }
   };
 
+  const lateAfterMs =
+    o.onLate && o.lateAfterMs !== undefined && o.lateAfterMs >= 0 ? o.lateAfterMs : Infinity;
+
+  /**
+   * The oldest call in flight: reported while it runs past `lateAfterMs`; past the hard limit
+   * the process is killed (and restarted by `crashed`).
+   */
+  const watchCalls = (): void => {
+    const p = proc;
+    if (!p || !ready || closed || inFlight.length === 0 || p.cause) return;
+    if (resets.length > 0 && resets[0] === 0) return; // the oldest call waits behind a reset
+    const running = performance.now() - headSince;
+    if (running > lateAfterMs) o.onLate?.(inFlight[0]!, running);
+    if (running <= hardLimitMs || closed || proc !== p) return;
+    timedOut = inFlight[0]!;
+    p.cause = `a call ran longer than its hard limit of ${formatS(hardLimitMs)} (HardLimit)`;
+    p.kill();
+  };
+
   /** Starts a process and loads the module; resolves when ready, rejects with a PythonLoadError. */
   const launch = async (): Promise<void> => {
-    const cmd = command(cwd);
+    const cmd = await command(cwd);
     const p = new Proc(
       cmd,
       cwd,
@@ -444,6 +548,8 @@ async function startSidecar(
         input_shape: [o.inputShape.rows, o.inputShape.cols],
         output_shape: o.outputShape ? [o.outputShape.rows, o.outputShape.cols] : null,
         cwd,
+        nice,
+        memory_limit_mb: o.memoryLimitMb ?? 0,
       });
       if (l.type === MSG.error) {
         const e = parseJson(l.payload);
@@ -480,17 +586,24 @@ async function startSidecar(
     if (closed) return;
     const lost = inFlight.splice(0);
     const tail = p?.stderr(6) ?? "";
+    const cause = p?.cause ?? "";
     for (const callId of lost) {
+      const hung = cause !== "" && callId === timedOut;
       o.onError(callId, {
-        message: `the Python process died (${reason})`,
+        message: hung
+          ? `${cause}: the Python process was killed`
+          : `the Python process died (${cause || reason})`,
         traceback: tail,
-        kind: "crash",
+        kind: hung ? "timeout" : "crash",
       });
     }
+    timedOut = -1;
+    resets.length = 0;
     if (wasReady && performance.now() - readySince > backoff.max) delay = backoff.first;
+    const pid = `the Python process (pid ${p?.pid ?? "?"})`;
     o.onStatus(
       "restarting",
-      `the Python process (pid ${p?.pid ?? "?"}) ${reason}; restarting in ${formatS(delay)}`,
+      `${cause ? `${cause}: ${pid} was killed` : `${pid} ${reason}`}; restarting in ${formatS(delay)}`,
     );
     scheduleRestart();
   };
@@ -528,6 +641,11 @@ async function startSidecar(
   await launch();
   ready = true;
   readySince = performance.now();
+  if (hardLimitMs < Infinity || lateAfterMs < Infinity) {
+    const every = Math.min(lateAfterMs < Infinity ? 50 : 250, Math.max(10, hardLimitMs / 8));
+    watchdog = setInterval(watchCalls, every);
+    watchdog.unref?.();
+  }
   o.onStatus("ready");
 
   return {
@@ -547,6 +665,7 @@ async function startSidecar(
       const p = proc;
       if (!ready || closed || !p) return -1;
       const callId = id();
+      if (inFlight.length === 0) headSince = performance.now();
       inFlight.push(callId);
       p.write(encodeCall(callId, values, o.inputShape.rows, o.inputShape.cols));
       return callId;
@@ -554,7 +673,13 @@ async function startSidecar(
     reset() {
       const p = proc;
       if (!ready || closed || !p) return;
+      resets.push(inFlight.length);
       void p.request(MSG.reset, id()).then(({ type, payload }) => {
+        if (proc === p && resets.length > 0) {
+          resets.shift();
+          // The calls sent meanwhile waited for `init`: their time starts now.
+          if (inFlight.length > 0) headSince = performance.now();
+        }
         if (type === MSG.error && !closed) {
           const e = parseJson(payload);
           o.onError(0, {
@@ -571,6 +696,8 @@ async function startSidecar(
       ready = false;
       if (retry) clearTimeout(retry);
       retry = undefined;
+      if (watchdog) clearInterval(watchdog);
+      watchdog = undefined;
       const p = proc;
       proc = undefined;
       p?.stop();

@@ -209,10 +209,21 @@ export interface PythonLoadOptions {
   cwd?: string;
   /** Who asks (for messages): "block 'Net'". */
   label: string;
+  /**
+   * A call not answered after this many ms is given up: the process is killed (the call and
+   * those behind it fail, the first with kind `timeout`) and restarted (default: none).
+   */
+  hardLimitMs?: number;
+  /** While a call has been running longer than this (ms), `onLate` reports it (every ~50 ms). */
+  lateAfterMs?: number;
+  /** The process's data memory limit in MB (RLIMIT_DATA; 0 or absent: none). */
+  memoryLimitMb?: number;
   /** A result (`values` is valid during the callback only) with the Python-side compute time. */
   onResult(id: number, values: Float64Array, computeUs: number): void;
   /** An exception in the user function (with its traceback), or a call lost to a crash. */
   onError(id: number, error: PythonCallError): void;
+  /** The oldest call in flight (`id`) has been running `runningMs` (beyond `lateAfterMs`). */
+  onLate?(id: number, runningMs: number): void;
   /** Process life: `restarting` after a crash (with the reason), `ready` when loaded again. */
   onStatus(state: PythonSidecarState, message?: string): void;
   /** Lines the user code printed (stdout and stderr of the process). */
@@ -224,7 +235,10 @@ export type PythonSidecarState = "ready" | "restarting" | "failed" | "closed";
 export interface PythonCallError {
   message: string;
   traceback: string;
-  /** `call` (an exception), `shape` (a result of another size), `crash` (the process died). */
+  /**
+   * `call` (an exception), `memory` (a MemoryError), `shape` (a result of another size), `crash`
+   * (the process died), `timeout` (the call passed the hard limit; the process was killed).
+   */
   kind: string;
 }
 

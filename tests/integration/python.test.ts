@@ -187,7 +187,8 @@ Other: { Type: Function, Inputs: [Emg], Params: { Operation: abs } }
     expect(first, stderr).toBeDefined();
     process.kill(first!, "SIGKILL");
     const code = await new Promise<number | null>((r) => cli.on("exit", r));
-    expect(code, stderr).toBe(0);
+    // The crash is a block error (issue 14): the run goes on, and exits 1 at the end.
+    expect(code, stderr).toBe(1);
     const tel = telemetry(stdout);
     const last = tel.at(-1)!.blocks.find((b) => b.name === "Py")!;
     // Reported (as a warning event and in the status), restarted under a new pid, running again.
@@ -219,7 +220,8 @@ Emg: { Type: EmgSimulator, Inputs: [Timer], Params: { Channels: 1 } }
     const r = runCli(["run", join(dir, "raise.yaml"), "--duration", "3", "--json"], {
       timeoutMs: 90_000,
     });
-    expect(r.code, r.stderr).toBe(0);
+    // Exceptions are block errors (issue 14): the run goes on, and exits 1 at the end.
+    expect(r.code, r.stderr).toBe(1);
     const events = jsonLines(r.stdout).filter((l) => l.type === "event" && l.block === "Py");
     const text = events.map((e) => String(e.message)).join("\n");
     expect(text).toMatch(

@@ -76,6 +76,13 @@ function manualBridge(opts: { fail?: Error & { kind?: string } } = {}) {
       ready = true;
       o.onStatus("ready", "restarted (pid 43)");
     },
+    restartFailed(): void {
+      o.onStatus("restarting", "restart failed: no python; retrying in 1 s");
+    },
+    /** The bridge's report of the oldest call still running after `ms`. */
+    late(ms: number): void {
+      o.onLate?.(calls[0]!.id, ms);
+    },
   };
 }
 
@@ -184,7 +191,10 @@ describe("Python block (fake sidecar)", () => {
       [6, 6],
       [6, 6],
     ]);
-    expect(h.warnings[0]).toMatch(/ValueError: bad \(before any good output\)\nTraceback…/);
+    // Errors, counted by the runtime like exceptions in `process`, with their traceback.
+    expect(h.errors).toHaveLength(2);
+    expect(h.errors[0]).toMatch(/ValueError: bad \(before any good output\)\nTraceback…/);
+    expect(h.warnings).toEqual([]);
     expect(h.text).toMatch(/2 errors \(last: ValueError: bad\)/);
     const { h: s, b: sb } = await harness({ OnError: "skip" });
     s.push(ev(1, 1, 1));
@@ -202,7 +212,9 @@ describe("Python block (fake sidecar)", () => {
     b.answer();
     h.push(ev(2, 2, 2));
     b.crash();
-    expect(h.warnings.join("\n")).toMatch(/killed by SIGKILL; restarting in 0\.5 s/);
+    // One error per crash (not per call it lost).
+    expect(h.errors).toHaveLength(1);
+    expect(h.errors[0]).toMatch(/killed by SIGKILL; restarting in 0\.5 s/);
     expect(h.text).toMatch(/restarting in 0\.5 s · 1 restart/);
     expect(h.output().t).toEqual([1, 2]); // the lost call held the last good output
     h.push(ev(3, 3, 3)); // sidecar down: waits
@@ -254,7 +266,30 @@ describe("Python block (fake sidecar)", () => {
     });
   });
 
-  test("under the virtual clock it warns that calls are not awaited", async () => {
+  test("a call still running past Budget is counted while it runs, once", async () => {
+    const { h, b } = await harness({ Budget: 10 });
+    expect(b.options).toMatchObject({ lateAfterMs: 10, hardLimitMs: 2000, memoryLimitMb: 4096 });
+    h.push(ev(1, 1, 1));
+    b.late(25);
+    b.late(60);
+    expect(h.text).toMatch(/pid 42 · call running for 60\.0 ms · .* · 1 over budget \(10\.0 ms\)/);
+    expect(h.computeReports.map((r) => [r.ms, r.budgetMs])).toEqual([
+      [25, 10],
+      [60, 10],
+    ]);
+    b.answer();
+    expect(h.text).toMatch(/pid 42 · p50 .* · 1 over budget/);
+    expect(h.text).not.toMatch(/running for/);
+  });
+
+  test("HardLimit: default 10 × Budget (at least 2 s), or as given; MemoryLimit passed on", async () => {
+    const { b } = await harness({ Budget: 500 });
+    expect(b.options.hardLimitMs).toBe(5000);
+    const { b: b2 } = await harness({ HardLimit: 300, MemoryLimit: 0 });
+    expect(b2.options).toMatchObject({ hardLimitMs: 300, memoryLimitMb: 0, lateAfterMs: 10 });
+  });
+
+  test("under the virtual clock every input gets its call, and results wait for flush", async () => {
     const b = manualBridge();
     const h = await BlockHarness.create(
       Python,
@@ -262,7 +297,51 @@ describe("Python block (fake sidecar)", () => {
       { inputs: [{ shape: vectorShape(2), rate: 100 }], io: { python: b.bridge }, virtual: true },
     );
     h.start();
-    expect(h.warnings[0]).toMatch(/virtual clock Python calls are not awaited/);
+    h.push(
+      Frame.from(
+        vectorShape(2),
+        [1, 2, 3],
+        [
+          [1, 0],
+          [2, 0],
+          [3, 0],
+        ],
+      ),
+    );
+    h.push(ev(4, 4, 0));
+    // One call in flight, three waiting: the engine waits for four results.
+    expect(b.calls.map((c) => c.values[0])).toEqual([1]);
+    expect(h.awaiting).toBe(4);
+    b.answer();
+    b.fail("ValueError: bad");
+    expect(h.awaiting).toBe(2);
+    b.answer();
+    b.answer();
+    expect(h.awaiting).toBe(0);
+    expect(h.output().t).toEqual([]); // held until the engine flushes
+    h.instance.flush?.();
+    expect(h.output().t).toEqual([1, 2, 3, 4]);
+    expect(h.output().v).toEqual([
+      [2, 1],
+      [2, 1], // hold: the failed call's output is the last good one
+      [4, 1],
+      [5, 1],
+    ]);
+    expect(h.text).not.toMatch(/skipped/);
+    expect(h.warnings).toEqual([]);
+    // A crash: the inputs wait for the restart; when the restart fails, they are given up.
+    h.push(ev(5, 5, 0));
+    h.push(ev(6, 6, 0));
+    b.crash();
+    expect(h.awaiting).toBe(1);
+    b.restartFailed();
+    expect(h.awaiting).toBe(0);
+    h.push(ev(7, 7, 0));
+    expect(h.awaiting).toBe(0);
+    expect(h.text).toMatch(/2 skipped/);
+    b.restarted();
+    h.push(ev(8, 8, 0));
+    expect(h.awaiting).toBe(1);
   });
 
   test("without a Python bridge (the browser build) it loads, says so and emits nothing", async () => {

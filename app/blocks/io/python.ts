@@ -40,6 +40,22 @@ const params = z.strictObject({
     .describe(
       "Milliseconds one call may take (default one period, 1000 / DesiredRate); longer calls are counted and mark the block stumbling",
     ),
+  HardLimit: z
+    .number()
+    .positive()
+    .max(86_400_000)
+    .optional()
+    .describe(
+      "Milliseconds after which a call that has not returned is given up: reported as an error, the Python process killed and restarted with backoff (default 10 × Budget, at least 2000; 10000 when there is no Budget)",
+    ),
+  MemoryLimit: z
+    .number()
+    .min(0)
+    .max(1_048_576)
+    .default(4096)
+    .describe(
+      "Megabytes of memory the Python process may allocate (its data segment, RLIMIT_DATA, set before the module is imported); an allocation beyond it raises a MemoryError that is reported with this limit. 0: no limit",
+    ),
   OnError: z
     .enum(["hold", "skip"])
     .default("hold")
@@ -75,6 +91,8 @@ function paramOf(kind: string, p: Params): string {
       return p.Init !== undefined ? "Init" : "Function";
     case "shape":
       return p.OutputShape !== undefined ? "OutputShape" : "Function";
+    case "memory":
+      return "MemoryLimit";
     default:
       return "Module";
   }
@@ -102,8 +120,80 @@ const ms = (x: number): string =>
         ? `${x.toFixed(1)} ms`
         : `${Math.round(x)} ms`;
 
+/** A duration of a call still running: ms below 10 s, then s. */
+const running = (x: number): string => (x < 10_000 ? ms(x) : `${(x / 1000).toFixed(1)} s`);
+
 const TIMES = 256;
 const WARN_EVERY_MS = 5000;
+/** The hard limit's default: this many budgets, at least HARD_MIN_MS (HARD_NO_BUDGET_MS without). */
+const HARD_BUDGETS = 10;
+const HARD_MIN_MS = 2000;
+const HARD_NO_BUDGET_MS = 10_000;
+
+/** Events (timestamp + values) waiting, oldest first: a ring that grows when full. */
+class EventQueue {
+  private t: Float64Array;
+  private v: Float64Array;
+  private head = 0;
+  n = 0;
+
+  constructor(
+    private readonly size: number,
+    private cap = 4,
+  ) {
+    this.t = new Float64Array(cap);
+    this.v = new Float64Array(cap * size);
+  }
+
+  push(values: Float64Array, t: number): void {
+    if (this.n === this.cap) this.grow();
+    this.put((this.head + this.n) % this.cap, values, t);
+    this.n++;
+  }
+
+  /** Replaces the newest event (there must be one). */
+  replaceNewest(values: Float64Array, t: number): void {
+    this.put((this.head + this.n - 1) % this.cap, values, t);
+  }
+
+  get oldestT(): number {
+    return this.t[this.head]!;
+  }
+
+  get oldest(): Float64Array {
+    return this.v.subarray(this.head * this.size, (this.head + 1) * this.size);
+  }
+
+  shift(): void {
+    this.head = (this.head + 1) % this.cap;
+    this.n--;
+  }
+
+  clear(): void {
+    this.head = 0;
+    this.n = 0;
+  }
+
+  private put(k: number, values: Float64Array, t: number): void {
+    this.t[k] = t;
+    this.v.set(values, k * this.size);
+  }
+
+  private grow(): void {
+    const cap = this.cap * 2;
+    const t = new Float64Array(cap);
+    const v = new Float64Array(cap * this.size);
+    for (let i = 0; i < this.n; i++) {
+      const k = (this.head + i) % this.cap;
+      t[i] = this.t[k]!;
+      v.set(this.v.subarray(k * this.size, (k + 1) * this.size), i * this.size);
+    }
+    this.t = t;
+    this.v = v;
+    this.cap = cap;
+    this.head = 0;
+  }
+}
 
 export const Python = defineBlock({
   type: "Python",
@@ -113,8 +203,9 @@ export const Python = defineBlock({
   help:
     "Reuses Python code inside a pipeline (paper III-J, V-(c)) without letting it stall the " +
     "pipeline: the function runs in a separate Python process (the sidecar, one per block, " +
-    "started with the pipeline from the uv environment in native-bridges/python), and the " +
-    "engine never waits for it. Every input event `x` (a float64 NumPy array [rows, cols]) is " +
+    "started with the pipeline from the uv environment in native-bridges/python, at a lower " +
+    "scheduling priority than the engine: nice + 10), and the engine never waits for it in " +
+    "real time. Every input event `x` (a float64 NumPy array [rows, cols]) is " +
     "sent to `Function(x)` — or `Function(x, state)` when `Init` names a function " +
     "`init(Params) -> state`, called once at load and again on reset; `state` is any Python " +
     "object kept in the sidecar. The function returns an array-like of a fixed shape (found at " +
@@ -122,15 +213,21 @@ export const Python = defineBlock({
     "While a call is outstanding (`MaxInFlight`), newer inputs wait in one slot, each replacing " +
     "the one before (counted as skipped): a slow function lowers the block's rate, so the block " +
     "and everything downstream show as lagging, and every call longer than `Budget` is counted " +
-    "and marks it stumbling, while branches that do not depend on it stay on time. The status " +
-    "shows call-time p50/p99 (round trip) and the over-budget count. An exception in the " +
-    "function is shown with its traceback and the block keeps running (`OnError`); a crashed " +
-    "or killed sidecar is reported and restarted with backoff (0.5 s doubling to 10 s), its " +
-    "state initialised again. A missing module, a syntax error (with file and line), a missing " +
-    "function or a result that is not an array is an error when the pipeline loads. Needs " +
-    "`mosaic run`, `mosaic serve` or the desktop app: the browser build has no Python and says " +
-    "so in the block's status (the rest of the pipeline runs). See docs/protocols.md for the " +
-    "wire format and pipelines/python/ for examples.",
+    "(a call still running as soon as it passes `Budget`) and marks it stumbling, while " +
+    "branches that do not depend on it stay on time. The status shows call-time p50/p99 (round " +
+    "trip), the over-budget count and how long a late call has been running. A call still " +
+    "running after `HardLimit` is given up: an error, the process is killed and restarted. An " +
+    "exception in the function is an error (counted like any block error, so `mosaic run` exits " +
+    "1) shown with its traceback, and the block keeps running (`OnError`); a crashed or killed " +
+    "sidecar is an error too, reported and restarted with backoff (0.5 s doubling to 10 s), its " +
+    "state initialised again. The process's memory is limited (`MemoryLimit`): an allocation " +
+    "beyond it raises a MemoryError, reported with the limit. Under the virtual clock the " +
+    "engine waits for every call (virtual time stands still meanwhile): no input is skipped " +
+    "and a replay gives the same output. A missing module, a syntax error (with file and line), " +
+    "a missing function or a result that is not an array is an error when the pipeline loads. " +
+    "Needs `mosaic run`, `mosaic serve` or the desktop app: the browser build has no Python and " +
+    "says so in the block's status (the rest of the pipeline runs). See docs/protocols.md for " +
+    "the wire format and pipelines/python/ for examples.",
   params,
   inputs: { min: 1, max: 1, labels: ["x"] },
   eventLoop: true,
@@ -147,6 +244,10 @@ export const Python = defineBlock({
     const inShape: Shape = input.shape;
     const inSize = shapeSize(inShape);
     const budgetMs = p.Budget ?? (ctx.desiredRate > 0 ? 1000 / ctx.desiredRate : Infinity);
+    const budget = budgetMs < Infinity ? budgetMs : undefined;
+    const hardLimitMs =
+      p.HardLimit ??
+      (budget !== undefined ? Math.max(HARD_BUDGETS * budget, HARD_MIN_MS) : HARD_NO_BUDGET_MS);
     const bridge = ctx.io.python;
     const declared: Shape | undefined = p.OutputShape
       ? { rows: p.OutputShape[0], cols: p.OutputShape[1] }
@@ -165,30 +266,37 @@ export const Python = defineBlock({
       };
     }
 
-    // Calls sent, oldest first: input timestamps and send times (results come back in order).
+    // Calls sent, oldest first: input timestamps, send times, and whether the call was already
+    // counted as over budget while it ran (results come back in order).
     const cap = p.MaxInFlight;
     const sentT = new Float64Array(cap);
     const sentAt = new Float64Array(cap);
+    const counted = new Uint8Array(cap);
     let head = 0;
     let count = 0;
-    // The one waiting input (newer ones replace it).
-    const waiting = new Float64Array(inSize);
-    let waitingT = 0;
-    let hasWaiting = false;
+    // Inputs waiting for a call: in real time one (newer ones replace it); under the virtual
+    // clock all of them (the engine waits for every call).
+    const waiting = new EventQueue(inSize, ctx.virtual ? 16 : 1);
+    // Results held for `flush` under the virtual clock (emitted in the engine's order).
+    let held: EventQueue | undefined;
     // Last good output (OnError: hold).
     let lastGood: Float64Array | undefined;
     let haveGood = false;
 
-    let running = false;
+    let runningNow = false;
     let calls = 0;
     let errors = 0;
     let overBudget = 0;
     let skipped = 0;
     let crashes = 0;
     let state = "loading";
+    /** The sidecar failed to restart: under the virtual clock, inputs are not waited for. */
+    let down = false;
     let lastError = "";
     let lastWarnAt = -Infinity;
     let lastText = "";
+    /** How long the oldest call has been running, when that is longer than the budget (ms). */
+    let lateFor = 0;
     const rtt = new Float64Array(TIMES);
     const py = new Float64Array(TIMES);
     const scratch = new Float64Array(TIMES);
@@ -212,8 +320,10 @@ export const Python = defineBlock({
       }
       let text: string;
       if (state === "ready") {
-        text = `pid ${sidecar?.pid ?? "?"} · ${pctText}`;
-        text += ` · ${overBudget} over budget${budgetMs < Infinity ? ` (${ms(budgetMs)})` : ""}`;
+        text = `pid ${sidecar?.pid ?? "?"}`;
+        if (lateFor > 0) text += ` · call running for ${running(lateFor)}`;
+        text += ` · ${pctText}`;
+        text += ` · ${overBudget} over budget${budget !== undefined ? ` (${ms(budget)})` : ""}`;
       } else {
         text = state;
       }
@@ -226,11 +336,17 @@ export const Python = defineBlock({
       }
     };
 
+    /** Under the virtual clock: how many results the engine must wait for. */
+    const awaiting = (): void => {
+      if (ctx.virtual) ctx.setAwaiting(runningNow ? count + waiting.n : 0);
+    };
+
     const send = (values: Float64Array, t: number): boolean => {
       if (count >= cap || !sidecar?.ready) return false;
       const k = (head + count) % cap;
       sentT[k] = t;
       sentAt[k] = performance.now();
+      counted[k] = 0;
       count++;
       if (sidecar.call(values) < 0) {
         count--;
@@ -239,77 +355,106 @@ export const Python = defineBlock({
       return true;
     };
 
-    /** Takes the oldest outstanding call: its input timestamp and its round-trip time (ms). */
-    const take = (): [number, number] | undefined => {
+    /**
+     * Takes the oldest outstanding call: its input timestamp, its round-trip time (ms), and
+     * whether it was counted over budget while it ran.
+     */
+    const take = (): [number, number, boolean] | undefined => {
       if (count === 0) return undefined;
       const t = sentT[head]!;
       const took = performance.now() - sentAt[head]!;
+      const wasCounted = counted[head] === 1;
       head = (head + 1) % cap;
       count--;
-      return [t, took];
+      lateFor = 0;
+      return [t, took, wasCounted];
     };
 
     const sendWaiting = (): void => {
-      if (hasWaiting && send(waiting, waitingT)) hasWaiting = false;
+      while (waiting.n > 0 && send(waiting.oldest, waiting.oldestT)) waiting.shift();
     };
 
     const emit = (t: number, values: Float64Array): void => {
-      if (!running) return;
+      if (!runningNow) return;
+      if (held) {
+        held.push(values, t);
+        return;
+      }
       const f = out.frame(1);
       f.t[0] = t;
       f.v.set(values);
       out.emit(f);
     };
 
-    const warnError = (message: string): void => {
+    const warnOutput = (message: string): void => {
       const now = performance.now();
       if (now - lastWarnAt < WARN_EVERY_MS) return;
       lastWarnAt = now;
       ctx.warn(message);
     };
 
+    /**
+     * An error: counted by the runtime like an exception in `process`; the status counts the
+     * function's errors (a lost process shows as a restart).
+     */
+    const failed = (message: string, traceback = "", restart = false): void => {
+      if (!restart) {
+        errors++;
+        lastError = message;
+      }
+      ctx.error(message, traceback.trimEnd() || undefined);
+    };
+
+    /** The oldest call, still running past the budget: counted now, and marks it stumbling. */
+    const onLate = (_id: number, runningMs: number): void => {
+      if (count === 0 || budget === undefined) return;
+      if (counted[head] === 0) {
+        counted[head] = 1;
+        overBudget++;
+      }
+      lateFor = runningMs;
+      ctx.reportCompute(runningMs, budget);
+      refresh(true);
+    };
+
     const onResult = (_id: number, values: Float64Array, computeUs: number): void => {
       const taken = take();
       if (!taken) return;
-      const [t, took] = taken;
+      const [t, took, wasCounted] = taken;
       calls++;
       rtt[timesAt] = took;
       py[timesAt] = computeUs / 1000;
       timesAt = (timesAt + 1) % TIMES;
       if (timesN < TIMES) timesN++;
-      if (took > budgetMs) overBudget++;
+      if (took > budgetMs && !wasCounted) overBudget++;
       // The call's duration is this block's compute: a call over budget marks it stumbling.
-      ctx.reportCompute(took, budgetMs < Infinity ? budgetMs : undefined);
+      ctx.reportCompute(took, budget);
       if (!lastGood) lastGood = new Float64Array(values.length);
       lastGood.set(values);
       haveGood = true;
       emit(t, values);
       sendWaiting();
+      awaiting();
       refresh();
     };
 
     const onError = (id: number, e: PythonCallError): void => {
       if (id === 0) {
         // Not a call: init raised on reset.
-        errors++;
-        lastError = e.message;
-        ctx.warn(`${e.message}${e.traceback ? `\n${e.traceback}` : ""}`);
+        failed(e.message, e.traceback);
         refresh(true);
         return;
       }
       const taken = take();
-      if (e.kind !== "crash") {
-        errors++;
-        lastError = e.message;
-        warnError(
-          `${e.message}${e.traceback ? `\n${e.traceback.trimEnd()}` : ""}${errors > 1 ? ` (${errors} errors so far)` : ""}`,
-        );
-      }
+      // A call lost to a crash or a kill: the restart's report counts it (once per process).
+      if (e.kind !== "crash" && e.kind !== "timeout") failed(e.message, e.traceback);
       if (taken) {
-        ctx.reportCompute(taken[1], budgetMs < Infinity ? budgetMs : undefined);
+        if (taken[1] > budgetMs && !taken[2]) overBudget++;
+        ctx.reportCompute(taken[1], budget);
         if (p.OnError === "hold" && haveGood && lastGood) emit(taken[0], lastGood);
       }
       sendWaiting();
+      awaiting();
       refresh(true);
     };
 
@@ -324,27 +469,46 @@ export const Python = defineBlock({
         ...(declared ? { outputShape: declared } : {}),
         cwd: ctx.resources.resolve("."),
         label: `block '${ctx.name}'`,
+        hardLimitMs,
+        ...(budget !== undefined ? { lateAfterMs: budget } : {}),
+        memoryLimitMb: p.MemoryLimit,
         onResult,
+        onLate,
         onError,
         onStatus(s, message) {
           if (!sidecar) return; // the load itself: its outcome is what `load` returns
           if (s === "restarting") {
-            if (state === "ready") crashes++;
-            state = message ?? "restarting";
+            const text = message ?? "the Python sidecar stopped; restarting";
+            if (state === "ready") {
+              // The process died (or was killed): one error, whatever it had in flight.
+              crashes++;
+              failed(text, "", true);
+            } else {
+              // A restart failed: the same outage goes on.
+              ctx.warn(text);
+              down = true;
+              if (ctx.virtual && waiting.n > 0) {
+                skipped += waiting.n;
+                waiting.clear();
+              }
+            }
+            state = text;
             count = 0;
             head = 0;
-            ctx.warn(message ?? "the Python sidecar stopped; restarting");
+            lateFor = 0;
           } else if (s === "ready") {
             state = "ready";
+            down = false;
             if (message) ctx.warn(`Python sidecar ${message}`);
             sendWaiting();
           } else if (s === "closed") {
             state = "closed";
           }
+          awaiting();
           refresh(true);
         },
         onOutput(line) {
-          warnError(`python: ${line}`);
+          warnOutput(`python: ${line}`);
         },
       });
       sidecar = await loadPromise;
@@ -366,43 +530,68 @@ export const Python = defineBlock({
         "OutputShape",
       );
     }
+    if (ctx.virtual) held = new EventQueue(shapeSize(sc.outputShape), 16);
     refresh(true);
 
     return {
       start() {
-        running = true;
-        if (ctx.virtual) {
-          // The virtual clock does not wait for the sidecar (no call blocks the engine).
-          ctx.warn(
-            "under the virtual clock Python calls are not awaited: results arrive in real time, inputs that come faster are skipped, and runs are not reproducible; use the real-time clock",
-          );
-        }
+        runningNow = true;
         refresh(true);
       },
       stop() {
-        running = false;
+        runningNow = false;
+        awaiting();
       },
       process(frame: Frame) {
         const stride = frame.stride;
         for (let e = 0; e < frame.n; e++) {
           const v = frame.v.subarray(e * stride, e * stride + inSize);
           const t = frame.t[e]!;
-          if (!hasWaiting && send(v, t)) continue;
-          // Busy (or restarting): this input waits, replacing an older waiting one.
-          if (hasWaiting) skipped++;
-          waiting.set(v);
-          waitingT = t;
-          hasWaiting = true;
+          if (waiting.n === 0 && send(v, t)) continue;
+          if (ctx.virtual) {
+            // Every input gets its call (unless the sidecar cannot be restarted).
+            if (down) skipped++;
+            else waiting.push(v, t);
+          } else if (waiting.n > 0) {
+            // Busy (or restarting): this input waits, replacing an older waiting one.
+            skipped++;
+            waiting.replaceNewest(v, t);
+          } else {
+            waiting.push(v, t);
+          }
         }
+        awaiting();
         refresh();
       },
+      // Under the virtual clock results are held until the engine has delivered everything it
+      // had (it waits for them), then go out here, in the engine's order of blocks.
+      ...(held
+        ? {
+            flush() {
+              const h = held!;
+              if (h.n === 0 || !runningNow) {
+                h.clear();
+                return;
+              }
+              const f = out.frame(h.n);
+              for (let i = 0; i < f.n; i++) {
+                f.t[i] = h.oldestT;
+                f.v.set(h.oldest, i * f.stride);
+                h.shift();
+              }
+              out.emit(f);
+            },
+          }
+        : {}),
       reset() {
-        hasWaiting = false;
+        waiting.clear();
+        held?.clear();
         haveGood = false;
+        awaiting();
         sc.reset();
       },
       dispose() {
-        running = false;
+        runningNow = false;
         sc.close();
       },
       actions: {

@@ -6,6 +6,14 @@ is named, finds the output shape with a probe call on zeros (with a throwaway st
 fresh `init`), and replies `ok {output_shape}` or `error {message, traceback}`. Then every
 `call` carries one input array and gets a `result` (the output array and the Python-side compute
 time) or an `error` with the exception's traceback; the sidecar keeps serving after an error.
+
+The host decides how long the process lives, and the process never outlives it: a watcher thread
+sees the end of the host's end of stdin (the host closed it, or died: POLLHUP, without reading a
+byte of the protocol) and ends the process after `EXIT_GRACE_S` even when the user's function is
+stuck; on Linux the kernel also kills it when its parent dies (PR_SET_PDEATHSIG). SIGINT is
+ignored (a Ctrl-C in a terminal reaches the whole process group; the host stops the sidecar
+itself). `load` may lower the process's priority (`nice`) and limit its memory
+(`memory_limit_mb`: RLIMIT_DATA, before the user's module is imported).
 """
 
 from __future__ import annotations
@@ -15,7 +23,10 @@ import importlib.util
 import inspect
 import os
 import platform
+import select
+import signal
 import sys
+import threading
 import time
 import traceback
 from dataclasses import dataclass, field
@@ -28,6 +39,97 @@ from . import protocol as P
 from .protocol import MessageType as T
 
 _PACKAGE_DIR = str(Path(__file__).resolve().parent)
+
+# After the host's end of stdin closes, how long the main thread may take to finish on its own
+# (it reads the `shutdown` before the end) before the process ends anyway.
+EXIT_GRACE_S = 0.2
+# Exit status after running out of memory outside the user's function (the host says so).
+EXIT_OUT_OF_MEMORY = 3
+
+
+def watch_host(fd: int, grace: float = EXIT_GRACE_S) -> threading.Thread:
+    """Ends the process `grace` seconds after the write end of pipe `fd` is closed everywhere.
+
+    poll() with an empty event mask reports only POLLHUP/POLLERR, so the protocol's bytes are left
+    to the main thread; the thread waits in poll() without the GIL.
+    """
+
+    def run() -> None:
+        p = select.poll()
+        p.register(fd, 0)
+        while True:
+            try:
+                events = p.poll()
+            except InterruptedError:  # pragma: no cover (PEP 475 retries)
+                continue
+            if any(ev & (select.POLLHUP | select.POLLERR | select.POLLNVAL) for _, ev in events):
+                break
+        time.sleep(grace)
+        os._exit(0)
+
+    t = threading.Thread(target=run, name="mosaic-host-watch", daemon=True)
+    t.start()
+    return t
+
+
+def die_with_parent() -> bool:
+    """Linux: SIGKILL when the parent (the host, or uv between them) dies. True when set."""
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        PR_SET_PDEATHSIG = 1
+        if libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) != 0:
+            return False
+    except (OSError, AttributeError):
+        return False
+    # The parent may have died before the call: then it never fires.
+    expected = os.environ.get("MOSAIC_PARENT_PID")
+    if expected and expected.isdigit() and os.getppid() != int(expected):
+        os._exit(0)
+    return True
+
+
+_limits_applied = False
+# The data memory limit in force, MB (0: none), for the messages.
+_memory_limit_mb: float = 0
+
+
+def apply_limits(request: dict) -> None:
+    """Lowers the priority by `nice` and caps the data segment at `memory_limit_mb` (once)."""
+    global _limits_applied, _memory_limit_mb
+    if _limits_applied:
+        return
+    _limits_applied = True
+    nice = int(request.get("nice") or 0)
+    if nice > 0:
+        try:
+            os.nice(nice)
+        except OSError:
+            pass
+    mb = request.get("memory_limit_mb") or 0
+    if mb and mb > 0:
+        import resource
+
+        limit = int(mb * 1024 * 1024)
+        _, hard = resource.getrlimit(resource.RLIMIT_DATA)
+        if hard != resource.RLIM_INFINITY and hard < limit:
+            limit = hard
+        resource.setrlimit(resource.RLIMIT_DATA, (limit, limit))
+        _memory_limit_mb = limit / (1024 * 1024)
+
+
+def memory_hint() -> str:
+    """What a MemoryError means here: the limit reached (and the param), or the machine's end."""
+    limit_mb = _memory_limit_mb
+    if limit_mb > 0:
+        return (
+            f"the sidecar's memory limit (MemoryLimit: {limit_mb:g} MB) was reached; "
+            "raise the block's MemoryLimit (MB, 0 for none) if the function needs more"
+        )
+    return "the machine is out of memory"
 
 
 class LoadError(Exception):
@@ -87,6 +189,13 @@ def import_user_module(spec: str, cwd: str | None) -> Any:
         except SyntaxError as e:
             sys.modules.pop(name, None)
             raise syntax_error(e) from None
+        except MemoryError as e:
+            sys.modules.pop(name, None)
+            raise LoadError(
+                f"importing {path} failed: {describe_exception(e)}; {memory_hint()}",
+                user_traceback(e),
+                "memory",
+            ) from None
         except Exception as e:
             sys.modules.pop(name, None)
             raise LoadError(
@@ -196,6 +305,7 @@ def load(request: dict) -> Loaded:
     expected = request.get("output_shape")
     if not module_spec:
         raise LoadError("no module given", kind="missing-module")
+    apply_limits(request)
     module = import_user_module(module_spec, cwd)
     mod_name = getattr(module, "__file__", None) or module_spec
 
@@ -229,6 +339,12 @@ def load(request: dict) -> Loaded:
             return fn()
         except LoadError:
             raise
+        except MemoryError as e:
+            raise LoadError(
+                f"{what} raised {describe_exception(e)}; {memory_hint()}",
+                user_traceback(e),
+                "memory",
+            ) from None
         except Exception as e:
             raise LoadError(f"{what} raised {describe_exception(e)}", user_traceback(e), what) from None
 
@@ -326,6 +442,10 @@ class Server:
         t0 = time.perf_counter_ns()
         try:
             y = np.asarray(lo.invoke(x, lo.state), dtype=np.float64)
+        except MemoryError as e:
+            message = f"{describe_exception(e)}; {memory_hint()}"
+            self.error(rid, message, user_traceback(e), "memory")
+            return
         except Exception as e:
             self.error(rid, describe_exception(e), user_traceback(e), "call")
             return
@@ -379,9 +499,13 @@ class Server:
 
 
 def main() -> int:
+    # The host stops the sidecar; a terminal's Ctrl-C (sent to the whole group) is not for us.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    die_with_parent()
     # The protocol owns the original stdin/stdout; user code that prints or reads stdin gets
     # stderr and /dev/null instead, so it cannot corrupt the stream.
     proto_in = os.fdopen(os.dup(0), "rb", buffering=0)
+    watch_host(proto_in.fileno())
     proto_out = os.fdopen(os.dup(1), "wb", buffering=0)
     devnull = os.open(os.devnull, os.O_RDONLY)
     os.dup2(devnull, 0)
@@ -389,9 +513,12 @@ def main() -> int:
     os.dup2(2, 1)
     sys.stdin = open(os.devnull)  # noqa: SIM115
     sys.stdout = sys.stderr
+    server = Server(proto_in, proto_out)
     try:
-        return Server(proto_in, proto_out).serve()
+        return server.serve()
     except BrokenPipeError:
         return 0
-    except KeyboardInterrupt:
-        return 0
+    except MemoryError:
+        # Outside the user's function (reading a request, sending a result): say so and end.
+        os.write(2, f"mosaic_sidecar: out of memory; {memory_hint()}\n".encode())
+        os._exit(EXIT_OUT_OF_MEMORY)

@@ -59,8 +59,9 @@ class Sidecar:
 
     def close(self) -> int:
         assert self.proc.stdin is not None
-        self.proc.stdin.write(P.message(P.MessageType.SHUTDOWN, 0))
-        self.proc.stdin.close()
+        if not self.proc.stdin.closed:
+            self.proc.stdin.write(P.message(P.MessageType.SHUTDOWN, 0))
+            self.proc.stdin.close()
         code = self.proc.wait(10)
         self.proc.stdout.close()  # type: ignore[union-attr]
         self.proc.stderr.close()  # type: ignore[union-attr]
@@ -72,4 +73,8 @@ def sidecar(tmp_path):
     s = Sidecar(tmp_path)
     yield s
     if s.proc.poll() is None:
-        s.close()
+        try:
+            s.close()
+        except (OSError, ValueError, subprocess.TimeoutExpired):
+            s.proc.kill()  # a failed test's stuck process: never left behind
+            s.proc.wait(5)
