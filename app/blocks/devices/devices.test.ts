@@ -73,7 +73,7 @@ describe("the original's device types load with their positional forms", () => {
       Port: "COM5",
       Channels: 10,
     });
-    expect(load("a: { Type: DLR_ADCBT, Inputs: [t] }").params).toEqual({ Port: "", Channels: 10 });
+    expect(load("a: { Type: DLR_ADCBT, Inputs: [t] }").params).toEqual({ Channels: 10 });
     expect(
       load("n: { Type: NilsPod, Inputs: [t], Params: [ 'aa:bb:cc:dd:ee:ff' ] }").params,
     ).toEqual({ Address: "aa:bb:cc:dd:ee:ff" });

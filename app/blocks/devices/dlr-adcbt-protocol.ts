@@ -15,7 +15,7 @@ export const DLR_MAX_CHANNELS = 123;
 
 /** The protocol module; undefined: not implemented yet. */
 export function dlrAdcBtProtocol(_link: {
-  Port: string;
+  Port?: string | undefined;
   Channels: number;
 }): DeviceProtocol | undefined {
   return undefined;

@@ -13,9 +13,9 @@ const params = z.strictObject({
     .string()
     .trim()
     .max(256)
-    .default("")
+    .optional()
     .describe(
-      "The serial port (COM5, /dev/rfcomm0, /dev/ttyUSB0); empty: choose it in the control panel, as in the original",
+      "The serial port (COM5, /dev/rfcomm0, /dev/ttyUSB0); unset: choose it in the control panel, as in the original",
     ),
   Channels: z
     .number()
@@ -61,7 +61,7 @@ export const DLR_ADCBT = defineBlock({
   panel: "Scope of the channels; the link's state and frames received.",
   create(ctx, p) {
     pacingTimer(ctx);
-    const port = p.Port === "" ? "a serial port (none chosen: set Port)" : `serial port ${p.Port}`;
+    const port = p.Port ? `serial port ${p.Port}` : "a serial port (none chosen: set Port)";
     return pacedDevice(ctx, {
       device: "DLR ADC/BT",
       target: `the DLR ADC/BT on ${port} at ${DLR_BAUD_RATE} Bd`,

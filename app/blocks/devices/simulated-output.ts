@@ -22,7 +22,7 @@ export const SimulatedOutput = defineBlock({
     Destination: z
       .string()
       .max(500)
-      .default("")
+      .optional()
       .describe(
         "Where that block would have sent, e.g. localhost:3334, COM50, ws://localhost:9090 /topic",
       ),
@@ -49,7 +49,7 @@ export const SimulatedOutput = defineBlock({
     });
     let units = 0;
     const throttle = new TextThrottle();
-    const to = p.Destination !== "" ? ` → ${p.Destination}` : "";
+    const to = p.Destination ? ` → ${p.Destination}` : "";
     const describe = (): void =>
       ctx.setText(`simulated ${p.Device}${to}: ${plural(units, p.Unit)} not sent`);
     describe();
