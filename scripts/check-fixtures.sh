@@ -20,6 +20,9 @@ GENERATORS=(
   "core-wasm/dsp/tests/fixtures/gen_artifact.py:artifact.json"
   "core-wasm/learn/tests/fixtures/gen_learn.py:learn.json"
   "core-wasm/learn/tests/fixtures/gen_emg_regression.py:emg_regression.json"
+  "core-wasm/learn/tests/fixtures/gen_lda.py:lda.json"
+  "app/blocks/signal/fixtures/gen_dds.py:dds.json"
+  "app/blocks/signal/fixtures/gen_envelope.py:envelope_5hz.csv"
 )
 
 # uv as installed by scripts/setup.sh (pip --user: `python3 -m uv`), or on PATH.
