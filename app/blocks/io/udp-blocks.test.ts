@@ -105,6 +105,21 @@ describe("UdpSender", () => {
     expect(udp.closed).toBe(1);
   });
 
+  test("a ControlAlgorithm's MOSAIC mapping goes out with its DOAs codes as subcategories", async () => {
+    const udp = fakeUdp();
+    const h = await BlockHarness.create(
+      UdpSender,
+      { Port: 5005 },
+      { inputs: [{ shape: vectorShape(11), type: "ControlAlgorithm" }], io: udp.io },
+    );
+    h.start();
+    h.push(Frame.from(vectorShape(11), [1], [[0, 1, 2, 3, 4, 5, 50, 50, 50, 9, 10]]));
+    const sent = udp.sent.map(decode);
+    // 0 ThumbFlexion … 8 WristPronationSupination; the enum's 9 (OpenHand) was never sent.
+    expect(sent.map((d) => d.subcategory)).toEqual([0, 1, 2, 3, 4, 5, 6, 7, 8, 10, 11]);
+    expect(sent.map((d) => d.values[0])).toEqual([0, 1, 2, 3, 4, 5, 50, 50, 50, 9, 10]);
+  });
+
   test("control: one datagram per value (count 1, f64, category 1, subcategory per DoF)", async () => {
     const udp = fakeUdp();
     const h = await BlockHarness.create(

@@ -7,6 +7,7 @@ import {
   type InputInfo,
   type UdpSocketHandle,
 } from "../../engine";
+import { ACTUATION_SIZE, DOAS } from "../control/actuation";
 import { signalInput } from "../shared/inputs";
 import { plural, TextThrottle } from "../shared/text";
 import {
@@ -73,7 +74,7 @@ const params = z.strictObject({
     "Streamlined only: category byte (default 0 for vector, 1 for control and myo; MOSAIC: 0 EMG, 1 position control, 2 FMG)",
   ).optional(),
   Subcategory: byteParam(
-    "Streamlined only: subcategory byte (default 0; 1 for myo); for control, the subcategory of the first value (value k gets Subcategory + k)",
+    "Streamlined only: subcategory byte (default 0; 1 for myo); for control, the subcategory of the first value (value k gets Subcategory + k; by default a ControlAlgorithm's 11-value MOSAIC mapping sends its DOAs codes 0–8, 10, 11)",
   ).optional(),
   Subcategories: z
     .array(byteParam("subcategory"))
@@ -105,6 +106,11 @@ interface Plan {
   category: number;
   subcategories: number[];
   scale: number;
+}
+
+/** A ControlAlgorithm's MOSAIC mapping: its 11 degrees of actuation (app/blocks/control/actuation.ts). */
+function isMosaicActuation(sourceType: string | undefined, size: number): boolean {
+  return sourceType === "ControlAlgorithm" && size === ACTUATION_SIZE;
 }
 
 /**
@@ -162,6 +168,9 @@ function plan(
         );
       }
       subs = p.Subcategories;
+    } else if (isMosaicActuation(sourceType, size) && p.Subcategory === undefined) {
+      // The MOSAIC mapping's degrees of actuation, sent with their DOAs codes as the original did.
+      subs = DOAS.map((d) => d.code);
     } else {
       const first = p.Subcategory ?? 0;
       if (first + size - 1 > 255) {
