@@ -6,7 +6,7 @@
  *   mosaic run FILE [options]          live per-block table (or --json lines); Ctrl-C stops cleanly
  *   mosaic bench [options]             the standard performance suite (see `mosaic bench --help`)
  */
-import { readFileSync, writeFileSync } from "node:fs";
+import { readFileSync, statSync, writeFileSync } from "node:fs";
 import { dirname, join, resolve } from "node:path";
 import { parseArgs } from "node:util";
 import { formatDiagnostic } from "../engine/diagnostics";
@@ -63,11 +63,14 @@ Usage:
       simulated signals) and prints its URL; --pipeline preselects one of pipelines/ (default
       the demo). Ctrl-C stops it.
   mosaic serve [FILE] [--port N] [--host ADDR] [--no-start] [--simulate-devices]
+               [--data-dir DIR]
       Runs the engine here (with UDP, serial and the other device bridges) and serves the UI
       for it: the same page as \`mosaic web\`, connected over a WebSocket that needs the token
       in the printed URL. FILE is loaded and started (--no-start: only loaded); several tabs
       may watch the same engine. Binds 127.0.0.1 unless --host says otherwise.
       --simulate-devices loads FILE with simulated devices (the page's switch does the same).
+      Pipelines loaded from the page read and write only in pipelines/, FILE's folder and
+      --data-dir DIR (data and model files, Path logs, Python modules).
   mosaic bench [--duration S] [--warmup S] [--only NAME[,NAME]] [--out DIR] [--quick]
       Runs the standard benchmarks and writes bench/results/*.json and *.md.
   mosaic --help | --version
@@ -455,8 +458,14 @@ async function cmdServe(args: string[]): Promise<number> {
       host: { type: "string", default: "127.0.0.1" },
       "no-start": { type: "boolean", default: false },
       "simulate-devices": { type: "boolean", default: false },
+      "data-dir": { type: "string" },
     },
   });
+  const dataDir = values["data-dir"] !== undefined ? resolve(values["data-dir"]) : undefined;
+  if (dataDir !== undefined && !statSync(dataDir, { throwIfNoEntry: false })?.isDirectory()) {
+    err(`mosaic serve: --data-dir ${dataDir} is not a folder`);
+    return 2;
+  }
   const port = Number(values.port);
   if (!Number.isInteger(port) || port < 0 || port > 65535) {
     err(`mosaic serve: --port must be a port number, not '${values.port}'`);
@@ -490,6 +499,7 @@ async function cmdServe(args: string[]): Promise<number> {
       host: values.host,
       // The UI names its examples "pipelines/x.yaml", relative to the repository (= the web root).
       pipelinesDir: join(dirname(root), ".."),
+      ...(dataDir !== undefined ? { dataDir } : {}),
       onProblem: (m) => err(`mosaic serve: ${m}`),
     });
   } catch (e) {

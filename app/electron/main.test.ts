@@ -51,6 +51,7 @@ function fakeElectron(userData: string, dialogs: { open?: string; save?: string 
     requestSingleInstanceLock = () => true;
     whenReady = () => Promise.resolve();
     getPath = (name: string) => (name === "userData" ? userData : tmpdir());
+    commandLine = { getSwitchValue: (_name: string) => "" };
     getVersion = () => "0.1.0";
     quit = () => {
       this.quitCalls++;

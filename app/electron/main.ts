@@ -19,7 +19,7 @@ import {
 } from "electron";
 import { existsSync } from "node:fs";
 import { isAbsolute, join, resolve } from "node:path";
-import { SessionHub } from "../host/session-hub";
+import { defaultAllowedDirs, SessionHub } from "../host/session-hub";
 import { ENGINE_CHANNEL, HOST_PROTOCOL_VERSION } from "./channel";
 import { buildMenuTemplate } from "./menu";
 import { appLayout } from "./paths";
@@ -281,6 +281,12 @@ async function ready(): Promise<void> {
   try {
     hub = await SessionHub.start({
       pipelinesDir: layout.pipelinesBase,
+      // What the window loads reads and writes only in the examples, the data folder
+      // (`--data-dir=DIR`, by default Documents/MOSAIC) and the folders of files opened here.
+      allowedDirs: defaultAllowedDirs(
+        layout.pipelinesBase,
+        app.commandLine.getSwitchValue("data-dir") || join(app.getPath("documents"), "MOSAIC"),
+      ),
       workerPath: layout.sessionWorker,
       wasmPath: layout.wasm,
       // The hub also tells every window (an error event), so no dialog here.

@@ -15,6 +15,8 @@ import type { RuntimeEvent, Telemetry } from "./runtime/runtime";
  * from the same build. A change that an older peer would misread raises it.
  */
 export const PROTOCOL_VERSION = 1;
+/** The versions this engine speaks (its `hello` lists them). */
+export const PROTOCOL_VERSIONS: readonly number[] = [PROTOCOL_VERSION];
 
 // ---------------------------------------------------------------------------------------------
 // UI → engine
@@ -72,6 +74,20 @@ export const uiMessageSchema = z.discriminatedUnion("type", [
 ]);
 
 export type UiMessage = z.infer<typeof uiMessageSchema>;
+
+/**
+ * For a `hello` whose version this engine does not speak (or that has none): the sentence the
+ * engine's `hello` answers it with (`error`). Undefined for any other message.
+ */
+export function unsupportedHello(raw: unknown): string | undefined {
+  if (raw === null || typeof raw !== "object" || (raw as { type?: unknown }).type !== "hello") {
+    return undefined;
+  }
+  const v = (raw as { version?: unknown }).version;
+  if (typeof v === "number" && PROTOCOL_VERSIONS.includes(v)) return undefined;
+  const said = v === undefined ? "no version" : `version ${JSON.stringify(v)?.slice(0, 40)}`;
+  return `this engine speaks protocol version ${PROTOCOL_VERSIONS.join(", ")}; the hello said ${said}`;
+}
 
 /** Validates a message from the UI; returns it or a sentence saying what is wrong. */
 export function parseUiMessage(
@@ -175,7 +191,16 @@ export interface DataMessage {
 }
 
 export type EngineMessage =
-  | { type: "hello"; version: number; engine: string; sharedMemory: boolean }
+  | {
+      type: "hello";
+      version: number;
+      /** Every version the engine speaks. */
+      versions?: readonly number[];
+      engine: string;
+      sharedMemory: boolean;
+      /** The client's hello named a version the engine does not speak (nothing else follows). */
+      error?: string;
+    }
   | {
       type: "reply";
       id: number;

@@ -9,11 +9,13 @@ import { catalogTypes, type Catalog } from "./catalog";
 import type { Clock } from "./clock";
 import { errorMessage, type Diagnostic } from "./diagnostics";
 import type { Frame } from "./frame";
-import { loadPipeline, type PipelineSpec } from "./pipeline/loader";
+import { loadPipeline, type LoadResult, type PipelineSpec } from "./pipeline/loader";
 import { withSimulatedDevices } from "./pipeline/simulate";
 import {
   PROTOCOL_VERSION,
+  PROTOCOL_VERSIONS,
   parseUiMessage,
+  unsupportedHello,
   type BlockInfo,
   type CatalogInfo,
   type DataMessage,
@@ -48,6 +50,11 @@ export interface SessionPlatform {
   /** File access relative to the pipeline file's folder. */
   resources(file: string): Resources;
   logs?(file: string): LogSink | undefined;
+  /**
+   * Parses and validates a pipeline file off this thread (the Node host's loader thread, so that
+   * a large file does not hold up other requests); `loadPipeline` here when absent.
+   */
+  loadPipeline?(source: string, file: string): Promise<LoadResult>;
   /** Device and network bridges for blocks (the Node host's; none in the browser). */
   io?: IoBridges;
   startLoop(rt: Runtime, hooks: LoopHooks): LoopHandle;
@@ -215,6 +222,8 @@ export class EngineSession {
   /** The loaded pipeline runs with simulated devices. */
   private simulated = false;
   private readonly watches = new Map<string, Watch>();
+  /** The load in progress (loads go one after another). */
+  private loading: Promise<unknown> = Promise.resolve();
 
   constructor(
     private readonly catalog: Catalog,
@@ -223,6 +232,11 @@ export class EngineSession {
 
   /** Handles one message from the UI (validated here). Never throws. */
   async handle(raw: unknown): Promise<void> {
+    const unsupported = unsupportedHello(raw);
+    if (unsupported !== undefined) {
+      this.platform.post({ ...this.hello(), error: unsupported });
+      return;
+    }
     const parsed = parseUiMessage(raw);
     if (!parsed.ok) {
       const id = (raw as { id?: unknown } | null)?.id;
@@ -265,19 +279,15 @@ export class EngineSession {
   private async dispatch(msg: UiMessage): Promise<void> {
     switch (msg.type) {
       case "hello":
-        this.platform.post({
-          type: "hello",
-          version: PROTOCOL_VERSION,
-          engine: this.platform.engine,
-          sharedMemory: this.platform.sharedMemory,
-        });
+        this.platform.post(this.hello());
         return;
       case "load": {
-        const { diagnostics, graph } = await this.load(
-          msg.file,
-          msg.source,
-          msg.simulateDevices === true,
+        // One load at a time: a load may wait for its parse (platform.loadPipeline).
+        const run = this.loading.then(() =>
+          this.load(msg.file, msg.source, msg.simulateDevices === true),
         );
+        this.loading = run.catch(() => {});
+        const { diagnostics, graph } = await run;
         const ok = graph !== undefined;
         this.reply(msg.id, ok, ok ? undefined : "the pipeline has errors", {
           diagnostics,
@@ -343,6 +353,16 @@ export class EngineSession {
     }
   }
 
+  private hello(): Extract<EngineMessage, { type: "hello" }> {
+    return {
+      type: "hello",
+      version: PROTOCOL_VERSION,
+      versions: PROTOCOL_VERSIONS,
+      engine: this.platform.engine,
+      sharedMemory: this.platform.sharedMemory,
+    };
+  }
+
   private requireRuntime(): Runtime {
     if (!this.rt) throw new Error("no pipeline is loaded");
     return this.rt;
@@ -356,11 +376,10 @@ export class EngineSession {
     this.unload();
     this.file = file;
     this.simulated = simulateDevices;
-    const loaded = withSimulatedDevices(
-      loadPipeline(source, file, this.catalog),
-      this.catalog,
-      simulateDevices ? {} : undefined,
-    );
+    const parsed = this.platform.loadPipeline
+      ? await this.platform.loadPipeline(source, file)
+      : loadPipeline(source, file, this.catalog);
+    const loaded = withSimulatedDevices(parsed, this.catalog, simulateDevices ? {} : undefined);
     if (!loaded.spec) {
       this.setState("empty");
       return { diagnostics: loaded.diagnostics };

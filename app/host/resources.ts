@@ -1,5 +1,6 @@
+import { realpathSync } from "node:fs";
 import { mkdir, readFile, rename, rm, writeFile } from "node:fs/promises";
-import { dirname, isAbsolute, resolve } from "node:path";
+import { basename, dirname, isAbsolute, relative, resolve } from "node:path";
 import type { Resources } from "../engine/block";
 
 /**
@@ -66,12 +67,65 @@ export async function flushWrites(): Promise<void> {
   }
 }
 
-/** File access for blocks: relative paths are resolved against the pipeline file's folder. */
-export function nodeResources(baseDir: string): Resources {
+/**
+ * `full` as it is on disk: symbolic links resolved, for the part that exists (a file about to be
+ * written, in folders about to be made, keeps the rest of its name).
+ */
+function onDisk(full: string): string {
+  let head = full;
+  const rest: string[] = [];
+  for (;;) {
+    try {
+      return resolve(realpathSync(head), ...rest);
+    } catch {
+      const up = dirname(head);
+      if (up === head) return full;
+      rest.unshift(basename(head));
+      head = up;
+    }
+  }
+}
+
+/**
+ * Folders a pipeline may read and write (app/host/session-hub.ts: pipelines loaded by clients of
+ * `mosaic serve` and of the desktop app). `check(full)` returns the sentence that refuses a path
+ * outside all of them (symbolic links followed), or undefined.
+ */
+export class AllowedFolders {
+  private readonly real: string[];
+  constructor(readonly dirs: readonly string[]) {
+    this.real = dirs.map((d) => onDisk(resolve(d)));
+  }
+
+  check(full: string, what = "use"): string | undefined {
+    const real = onDisk(full);
+    for (const root of this.real) {
+      const rel = relative(root, real);
+      if (rel === "" || (!rel.startsWith("..") && !isAbsolute(rel))) return undefined;
+    }
+    return (
+      `${full} is outside the folders this pipeline may ${what} (${this.dirs.join(", ")}): a ` +
+      "pipeline loaded by a client of `mosaic serve` or by the desktop app's window reads and " +
+      "writes only in its own folder and the data folder (`mosaic serve --data-dir DIR`)"
+    );
+  }
+}
+
+/**
+ * File access for blocks: relative paths are resolved against the pipeline file's folder. With
+ * `allowed`, every path must lie in one of those folders (see AllowedFolders).
+ */
+export function nodeResources(baseDir: string, allowed?: AllowedFolders): Resources {
+  const confine = (p: string, what: string): string => {
+    const full = isAbsolute(p) ? p : resolve(baseDir, p);
+    const refused = allowed?.check(full, what);
+    if (refused !== undefined) throw new Error(refused);
+    return full;
+  };
   return {
-    resolve: (p: string) => (isAbsolute(p) ? p : resolve(baseDir, p)),
+    resolve: (p: string) => confine(p, "use"),
     readText: async (p: string) => {
-      const full = isAbsolute(p) ? p : resolve(baseDir, p);
+      const full = confine(p, "read");
       try {
         return await readFile(full, "utf8");
       } catch (e) {
@@ -83,7 +137,7 @@ export function nodeResources(baseDir: string): Resources {
       }
     },
     writeText: async (p: string, text: string) => {
-      const full = isAbsolute(p) ? p : resolve(baseDir, p);
+      const full = confine(p, "write");
       try {
         await enqueue(full, text);
       } catch (e) {

@@ -4,6 +4,15 @@
  * 127.0.0.1 by default. The WebSocket needs the session's random token (in the printed URL) and
  * a same-origin page: another site open in the same browser cannot drive the devices. Several
  * tabs may watch and control the same engine; closing one changes nothing for the others.
+ *
+ * Pipelines loaded over the socket read and write only inside the allowed folders (the examples'
+ * folder, `--data-dir`, the folder of the file named on the command line; SessionHubOptions).
+ *
+ * Slow clients: what waits on a client's socket (`ws`'s `bufferedAmount`) is bounded. Above
+ * `dropAboveBytes` its telemetry (replaced 20 times a second), panel data and events are dropped
+ * and counted; a client whose waiting bytes have not gone down for `stalledMs`, or that has more
+ * than `maxBufferedBytes` waiting, is disconnected (close code 1008 and the reason), and its
+ * socket destroyed `closeGraceMs` later if it does not read the close.
  */
 import { randomBytes, timingSafeEqual } from "node:crypto";
 import type { IncomingMessage } from "node:http";
@@ -11,8 +20,39 @@ import type { Duplex } from "node:stream";
 import { WebSocketServer, type WebSocket } from "ws";
 import { errorMessage } from "../engine/diagnostics";
 import { decodeWire, encodeWire } from "../engine/protocol-wire";
-import { SessionHub, type SessionHubOptions } from "./session-hub";
+import { defaultAllowedDirs, SessionHub, type SessionHubOptions } from "./session-hub";
 import { serveStatic, type WebServer } from "./web-server";
+
+export interface SlowClientLimits {
+  /** Bytes waiting on a client's socket above which its telemetry, data and events are dropped. */
+  dropAboveBytes: number;
+  /** Bytes waiting above which the client is disconnected at once. */
+  maxBufferedBytes: number;
+  /** A client with more than `dropAboveBytes` waiting that read none of it for this long goes. */
+  stalledMs: number;
+  /** How long a disconnected client has to read the close frame before its socket is destroyed. */
+  closeGraceMs: number;
+}
+
+export const SLOW_CLIENT_LIMITS: Readonly<SlowClientLimits> = {
+  dropAboveBytes: 256 * 1024,
+  maxBufferedBytes: 32 * 1024 * 1024,
+  stalledMs: 10_000,
+  closeGraceMs: 2_000,
+};
+
+/** The WebSocket close code for a client too slow to keep (RFC 6455: policy violation). */
+export const CLOSE_TOO_SLOW = 1008;
+
+export interface ServeStats {
+  clients: number;
+  /** Bytes waiting on each client's socket. */
+  waiting: number[];
+  /** Messages left out for slow clients, by type. */
+  dropped: { telemetry: number; data: number; event: number };
+  /** Clients disconnected for being too slow, with the reason each was given. */
+  disconnected: string[];
+}
 
 export interface ServeOptions extends SessionHubOptions {
   /** The browser build (dist/web). */
@@ -21,6 +61,12 @@ export interface ServeOptions extends SessionHubOptions {
   host?: string;
   /** Fixed token (tests); a random one by default. */
   token?: string;
+  /**
+   * A folder pipelines loaded over the socket may read and write besides their own
+   * (`mosaic serve --data-dir DIR`); see allowedDirs.
+   */
+  dataDir?: string;
+  slowClients?: Partial<SlowClientLimits>;
 }
 
 export interface Served {
@@ -30,6 +76,8 @@ export interface Served {
   port: number;
   hub: SessionHub;
   web: WebServer;
+  /** Clients, and what slow ones were left out of or disconnected for. */
+  stats(): ServeStats;
   close(): Promise<void>;
 }
 
@@ -45,7 +93,10 @@ export async function serve(o: ServeOptions): Promise<Served> {
   const web = await serveStatic(o.webRoot, o.port, host);
   let hub: SessionHub;
   try {
-    hub = await SessionHub.start(o);
+    hub = await SessionHub.start({
+      ...o,
+      allowedDirs: o.allowedDirs ?? defaultAllowedDirs(o.pipelinesDir, o.dataDir),
+    });
   } catch (e) {
     await web.close();
     throw e;
@@ -99,31 +150,101 @@ export async function serve(o: ServeOptions): Promise<Served> {
     return text;
   };
 
+  const limits: SlowClientLimits = { ...SLOW_CLIENT_LIMITS, ...o.slowClients };
+  const stats: Omit<ServeStats, "waiting"> = {
+    clients: 0,
+    dropped: { telemetry: 0, data: 0, event: 0 },
+    disconnected: [],
+  };
+  /** Per socket: the bytes it had waiting at the last look, and since when none were read. */
+  const watch = new Map<WebSocket, { last: number; since: number | undefined; left: boolean }>();
+
+  const disconnect = (ws: WebSocket, reason: string): void => {
+    const w = watch.get(ws);
+    if (!w || w.left) return;
+    w.left = true;
+    stats.disconnected.push(reason);
+    o.onProblem?.(`a client was disconnected: ${reason}`);
+    ws.close(CLOSE_TOO_SLOW, reason.slice(0, 120));
+    setTimeout(() => ws.terminate(), limits.closeGraceMs).unref();
+  };
+
+  /** False when the client is gone or was just disconnected. */
+  const keep = (ws: WebSocket, now: number): boolean => {
+    const w = watch.get(ws);
+    if (!w || w.left) return false;
+    const waiting = ws.bufferedAmount;
+    const mib = (waiting / (1024 * 1024)).toFixed(1);
+    if (waiting > limits.maxBufferedBytes) {
+      disconnect(ws, `too slow: ${mib} MiB waiting to be sent`);
+      return false;
+    }
+    if (waiting <= limits.dropAboveBytes || waiting < w.last) w.since = undefined;
+    else w.since ??= now;
+    w.last = waiting;
+    if (w.since !== undefined && now - w.since >= limits.stalledMs) {
+      disconnect(ws, `stalled: read nothing of ${mib} MiB for ${limits.stalledMs / 1000} s`);
+      return false;
+    }
+    return true;
+  };
+  const sweep = setInterval(
+    () => {
+      const now = Date.now();
+      for (const ws of watch.keys()) keep(ws, now);
+    },
+    Math.min(500, limits.stalledMs / 4),
+  );
+  sweep.unref();
+
   const attach = (ws: WebSocket): void => {
+    watch.set(ws, { last: 0, since: undefined, left: false });
+    stats.clients++;
     const conn = hub.connect({
       send(msg) {
-        if (ws.readyState !== ws.OPEN) return;
-        // Panel data is best effort: a tab that cannot keep up (hidden, slow) skips frames
-        // rather than queueing without bound.
-        if (msg.type === "data" && ws.bufferedAmount > 4 * 1024 * 1024) return;
+        if (ws.readyState !== ws.OPEN || !keep(ws, Date.now())) return;
+        // Telemetry (replaced 20 times a second), panel data and events are best effort: a tab
+        // that cannot keep up (hidden, slow, stalled) skips them rather than queueing them.
+        if (
+          (msg.type === "telemetry" || msg.type === "data" || msg.type === "event") &&
+          ws.bufferedAmount > limits.dropAboveBytes
+        ) {
+          stats.dropped[msg.type]++;
+          return;
+        }
         ws.send(encode(msg));
       },
     });
     ws.on("message", (data, isBinary) => {
       if (isBinary) return;
       let msg: unknown;
+      const text = String(data);
       try {
-        msg = decodeWire(String(data));
+        msg = decodeWire(text);
       } catch (e) {
+        // JSON too deep for the decoder's walk still parses: answer its id.
+        let id = -1;
+        try {
+          const raw = JSON.parse(text) as { id?: unknown } | null;
+          if (typeof raw?.id === "number") id = raw.id;
+        } catch {
+          // not JSON at all
+        }
+        const why = e instanceof RangeError ? "the message nests too deeply" : "not JSON";
         ws.send(
-          encodeWire({ type: "reply", id: -1, ok: false, message: `not JSON: ${errorMessage(e)}` }),
+          encodeWire({ type: "reply", id, ok: false, message: `${why}: ${errorMessage(e)}` }),
         );
         return;
       }
       conn.receive(msg);
     });
-    ws.on("close", () => conn.close());
-    ws.on("error", () => conn.close());
+    const gone = (): void => {
+      if (!watch.delete(ws)) return;
+      stats.clients--;
+      conn.close();
+    };
+    ws.on("close", gone);
+    ws.on("error", gone);
   };
 
   const url = `${web.url}?token=${encodeURIComponent(token)}`;
@@ -133,7 +254,14 @@ export async function serve(o: ServeOptions): Promise<Served> {
     port,
     hub,
     web,
+    stats: () => ({
+      ...stats,
+      waiting: [...watch.keys()].map((ws) => ws.bufferedAmount),
+      dropped: { ...stats.dropped },
+      disconnected: [...stats.disconnected],
+    }),
     async close() {
+      clearInterval(sweep);
       for (const c of wss.clients) c.terminate();
       wss.close();
       await hub.close();

@@ -9,13 +9,15 @@
  * on. `Path` logs are written here, and serial ports are opened here (see serial-proxy.ts).
  */
 import { existsSync } from "node:fs";
-import { dirname, join } from "node:path";
+import { dirname, isAbsolute, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
 import { Worker } from "node:worker_threads";
 import { errorMessage } from "../engine/diagnostics";
 import {
   parseUiMessage,
   PROTOCOL_VERSION,
+  PROTOCOL_VERSIONS,
+  unsupportedHello,
   type EngineMessage,
   type GraphInfo,
   type UiMessage,
@@ -46,6 +48,15 @@ export interface SessionHubOptions {
   pipelinesDir: string;
   workerPath?: string;
   wasmPath?: string;
+  /**
+   * Confines the pipelines that clients load (browser tabs over the socket, a desktop window) to
+   * these folders: everything they read and write (data and model files, `Path` logs, Python
+   * modules) must lie inside one of them, or it is refused with a message that says so. The
+   * folder of every pipeline the host loads itself (`request`: `mosaic serve FILE`, the desktop
+   * app's File → Open) joins them; those loads are not confined, as with `mosaic run`.
+   * Undefined: nothing is confined.
+   */
+  allowedDirs?: string[];
   /** The session worker died or a log could not be written. */
   onProblem?(message: string): void;
 }
@@ -58,6 +69,8 @@ interface Pending {
   client?: Client;
   clientId: number;
   resolve?: (r: Reply) => void;
+  /** A load: the next may go once this one is answered. */
+  done?: () => void;
 }
 
 interface Client {
@@ -67,6 +80,14 @@ interface Client {
   open: boolean;
   /** Said hello: gets broadcasts from then on (its first messages are hello, graph, state). */
   greeted: boolean;
+}
+
+/**
+ * The folders pipelines loaded by clients may use by default: the examples' folder the UI lists
+ * ("pipelines/…" under `pipelinesDir`) and the data folder.
+ */
+export function defaultAllowedDirs(pipelinesDir: string, dataDir?: string): string[] {
+  return [join(pipelinesDir, "pipelines"), ...(dataDir !== undefined ? [dataDir] : [])];
 }
 
 export function defaultSessionWorkerPath(): string {
@@ -98,8 +119,15 @@ export class SessionHub {
   private exited = false;
   private closing = false;
   private readonly ready: Promise<void>;
+  /** Loads go one at a time (each with the folders it may use): the last one queued. */
+  private loads: Promise<void> = Promise.resolve();
+  /** See SessionHubOptions.allowedDirs. */
+  private readonly allowed: Set<string> | undefined;
 
   private constructor(private readonly options: SessionHubOptions) {
+    this.allowed = options.allowedDirs
+      ? new Set(options.allowedDirs.map((d) => resolve(d)))
+      : undefined;
     this.worker = new Worker(options.workerPath ?? defaultSessionWorkerPath(), {
       name: "mosaic-session",
       resourceLimits: { maxYoungGenerationSizeMb: 8 },
@@ -156,14 +184,49 @@ export class SessionHub {
     });
   }
 
-  private toWorker(m: HubToSession): void {
-    if (this.exited) return;
-    this.worker.postMessage(m);
+  /** False when the message could not be passed (it cannot be cloned: a value nested too deep). */
+  private toWorker(m: HubToSession): boolean {
+    if (this.exited) return true;
+    try {
+      this.worker.postMessage(m);
+    } catch {
+      return false;
+    }
     if (this.doorbell) {
       Atomics.store(this.doorbell, 1, 1);
       Atomics.add(this.doorbell, 0, 1);
       Atomics.notify(this.doorbell, 0);
     }
+    return true;
+  }
+
+  /** Where a pipeline's relative paths start (as the session worker resolves them). */
+  private folderOf(file: string): string {
+    return dirname(isAbsolute(file) ? file : resolve(this.options.pipelinesDir, file));
+  }
+
+  /**
+   * Sends request `id` (a `load`, pending already) once the loads before it are answered, after
+   * the folders it may use (`dirs`, null: anywhere).
+   */
+  private sendLoad(id: number, msg: Extract<UiMessage, { type: "load" }>, dirs: string[] | null) {
+    this.loads = this.loads.then(
+      () =>
+        new Promise<void>((done) => {
+          const p = this.pending.get(id);
+          if (!p || this.exited) return done();
+          p.done = done;
+          this.toWorker({ type: "confine", dirs });
+          if (!this.toWorker({ ...msg, id })) {
+            this.fromWorker({
+              type: "reply",
+              id,
+              ok: false,
+              message: "the pipeline cannot be passed to the engine",
+            });
+          }
+        }),
+    );
   }
 
   private broadcast(m: EngineMessage): void {
@@ -182,6 +245,7 @@ export class SessionHub {
         const p = this.pending.get(m.id);
         this.pending.delete(m.id);
         if (!p) return;
+        p.done?.();
         if (m.graph !== undefined && m.ok) this.graph = m.graph;
         else if (m.diagnostics !== undefined && !m.ok) this.graph = undefined;
         const reply: Reply = { ...m, id: p.clientId };
@@ -245,6 +309,13 @@ export class SessionHub {
     return new Promise((resolve) => {
       const id = this.nextId++;
       this.pending.set(id, { clientId: id, resolve });
+      if (msg.type === "load") {
+        // The host's own choice (a file named on its command line, opened from its menu): not
+        // confined, and its folder is the clients' too from now on.
+        this.allowed?.add(this.folderOf(msg.file));
+        this.sendLoad(id, { ...msg, id }, null);
+        return;
+      }
       this.toWorker({ ...msg, id } as HubToSession);
     });
   }
@@ -257,6 +328,19 @@ export class SessionHub {
     return {
       receive: (raw) => {
         if (!client.open) return;
+        const unsupported = unsupportedHello(raw);
+        if (unsupported !== undefined) {
+          const hello = this.hello?.type === "hello" ? this.hello : undefined;
+          sink.send({
+            type: "hello",
+            version: PROTOCOL_VERSION,
+            versions: PROTOCOL_VERSIONS,
+            engine: hello?.engine ?? "node host",
+            sharedMemory: hello?.sharedMemory ?? true,
+            error: unsupported,
+          });
+          return;
+        }
         const parsed = parseUiMessage(raw);
         if (!parsed.ok) {
           const id = (raw as { id?: unknown } | null)?.id;
@@ -292,7 +376,19 @@ export class SessionHub {
   private forward(client: Client, msg: Extract<UiMessage, { id: number }>): void {
     const id = this.nextId++;
     this.pending.set(id, { client, clientId: msg.id });
-    this.toWorker({ ...msg, id });
+    if (msg.type === "load") {
+      this.sendLoad(id, msg, this.allowed ? [...this.allowed] : null);
+      return;
+    }
+    if (!this.toWorker({ ...msg, id })) {
+      this.pending.delete(id);
+      client.sink.send({
+        type: "reply",
+        id: msg.id,
+        ok: false,
+        message: "the message cannot be passed to the engine (a value nested too deeply?)",
+      });
+    }
   }
 
   private watch(client: Client, msg: Extract<UiMessage, { type: "watch" | "unwatch" }>): void {

@@ -14,6 +14,12 @@ export type HubToSession =
       pipelinesDir: string;
       timeBase: TimeBase;
     }
+  /**
+   * The folders the pipelines loaded from now on may read and write (null: anywhere). The hub
+   * sends it before every `load` (loads go one at a time): a client's are confined, the host's own
+   * are not.
+   */
+  | { type: "confine"; dirs: string[] | null }
   | UiMessage
   | SerialReply
   | BleReply;
