@@ -526,7 +526,7 @@ class Check {
 function describe(v: Json): string {
   if (v === undefined) return "missing";
   if (v === null) return "null";
-  if (typeof v === "string") return `"${v.length > 30 ? v.slice(0, 30) + "…" : v}"`;
+  if (typeof v === "string") return JSON.stringify(v.length > 30 ? v.slice(0, 30) + "…" : v);
   if (Array.isArray(v)) return `a list of ${v.length}`;
   if (typeof v === "object") return "an object";
   return String(v);
@@ -543,7 +543,9 @@ export function parseModelFile(text: string, file: string): ModelFile {
   try {
     doc = JSON.parse(text);
   } catch (e) {
-    c.fail(`not a MOSAIC model file: invalid JSON (${errorMessage(e)})`);
+    // Not JSON.parse's whole message: it quotes the text around the error (`"root:$6$ab"...`).
+    const said = JSON.stringify(errorMessage(e).split(', "')[0]).slice(1, -1);
+    c.fail(`not a MOSAIC model file: invalid JSON (${said})`);
   }
   const top = c.object(doc, "the file");
   if (top.format !== MODEL_FORMAT) {

@@ -70,7 +70,13 @@ const isSkipped = (line: string): boolean => {
   return t === "" || t.startsWith("#");
 };
 
+/** A short, escaped excerpt of the file for messages (control characters as \u escapes). */
 const quote = (s: string): string => JSON.stringify(s.length > 30 ? s.slice(0, 30) + "…" : s);
+/** The header's names for messages: a few excerpts (the first line may be anything at all). */
+const listNames = (names: readonly string[]): string =>
+  names.length <= 8
+    ? names.map(quote).join(", ")
+    : `${names.slice(0, 8).map(quote).join(", ")}, … (${names.length} in all)`;
 
 export function parseDelimited(text: string, o: ParseOptions): ParsedTable {
   const all = text.split(/\r?\n/);
@@ -110,8 +116,8 @@ export function parseDelimited(text: string, o: ParseOptions): ParsedTable {
     if (i < 0) {
       const s = closest(ref, names);
       throw new BlockConfigError(
-        `'${o.file}' has no column '${ref}' (its columns: ${names.join(", ")})` +
-          (s !== undefined ? `; did you mean '${s}'?` : ""),
+        `'${o.file}' has no column '${ref}' (its columns: ${listNames(names)})` +
+          (s !== undefined ? `; did you mean ${quote(s)}?` : ""),
         param,
       );
     }
@@ -134,7 +140,7 @@ export function parseDelimited(text: string, o: ParseOptions): ParsedTable {
       : names.map((_, i) => i).filter((i) => i !== timeColumn);
   if (columns.length === 0) {
     throw new BlockConfigError(
-      `'${o.file}' has no data columns besides its time column '${names[timeColumn]}'`,
+      `'${o.file}' has no data columns besides its time column ${quote(names[timeColumn]!)}`,
       "Columns",
     );
   }
@@ -167,7 +173,7 @@ export function parseDelimited(text: string, o: ParseOptions): ParsedTable {
       const v = parseField(fields[col]!);
       if (v === undefined) {
         throw new BlockConfigError(
-          `line ${lineNo} of '${o.file}': field ${col + 1} (column '${names[col]}') is ` +
+          `line ${lineNo} of '${o.file}': field ${col + 1} (column ${quote(names[col]!)}) is ` +
             `${quote(fields[col]!)}, which is not a number`,
           "File",
         );

@@ -254,7 +254,7 @@ describe("FilePlayer", () => {
     const fail = (params: object, opts: HarnessOptions = {}) =>
       expect(player(params, files, opts)).rejects;
     await fail({ File: "bad.csv" }).toThrow(
-      `line 3 of 'bad.csv': field 3 (column 'b') is "abc", which is not a number`,
+      `line 3 of 'bad.csv': field 3 (column "b") is "abc", which is not a number`,
     );
     await fail({ File: "short.csv" }).toThrow(
       "line 3 of 'short.csv' has 1 field; expected 2 like line 1",
@@ -267,7 +267,7 @@ describe("FilePlayer", () => {
       "line 4 of 'back.csv': time 0.5 is before the previous row's 1",
     );
     await fail({ File: "notime.csv", Columns: ["bb"] }, { inputs: [timer] }).toThrow(
-      "'notime.csv' has no column 'bb' (its columns: a, b); did you mean 'b'?",
+      `'notime.csv' has no column 'bb' (its columns: "a", "b"); did you mean "b"?`,
     );
     await fail({ File: "notime.csv", Columns: [5] }, { inputs: [timer] }).toThrow(
       "column index 5 is out of range: 'notime.csv' has 2 columns (valid: 0–1)",
