@@ -448,15 +448,22 @@ export class EngineSession {
     return this.catalogCache;
   }
 
+  /** The params' JSON Schema of each block type (graph). */
+  private readonly schemas = new WeakMap<object, unknown>();
+
   private graph(): GraphInfo {
     const rt = this.rt!;
     const blocks: BlockInfo[] = this.spec!.blocks.map((b) => {
       const node = rt.node(b.name)!;
-      let schema: unknown = {};
-      try {
-        schema = z.toJSONSchema(b.def.params, { io: "input", unrepresentable: "any" });
-      } catch {
-        schema = {};
+      // Once per block type: a pipeline of thousands of blocks has a few dozen types.
+      let schema = this.schemas.get(b.def);
+      if (schema === undefined) {
+        try {
+          schema = z.toJSONSchema(b.def.params, { io: "input", unrepresentable: "any" });
+        } catch {
+          schema = {};
+        }
+        this.schemas.set(b.def, schema);
       }
       const own = Object.entries(node.instance.actions ?? {}).map(([name, a]) => ({
         name,

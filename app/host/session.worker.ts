@@ -41,7 +41,7 @@ import { clockFromBase } from "./time-base";
 import type { HubToSession, SessionToHub } from "./session-protocol";
 
 /** Files up to this size are parsed here (a few milliseconds); larger ones in the loader. */
-const INLINE_CHARS = 64 * 1024;
+const INLINE_CHARS = 32 * 1024;
 /** The loader's memory (MB) and time (s) before it is stopped and the load refused. */
 const LOADER_MEMORY_MB = 1024;
 const LOADER_TIME_S = 60;
