@@ -9,6 +9,14 @@
  * Errors never throw into the block: they come back through `onError` as one line that says what
  * went wrong and what to do (port in use, address not on this machine, host not found, nothing
  * listening at the destination).
+ *
+ * A sender (a socket opened with `remote`) loses no datagram silently: **every datagram it does not
+ * send is one `onError` call**, whatever the cause — the host name does not resolve (each datagram
+ * queued meanwhile, and every later one until a new lookup, retried at most every
+ * RESOLVE_RETRY_S, succeeds), the queue overflows while connecting, or the send fails later
+ * (ECONNREFUSED when nothing listens, EHOSTUNREACH…: every send carries a completion callback,
+ * because Node drops a failed send without one silently). So a block counts its `onError` calls
+ * as datagrams not sent.
  */
 import { createSocket, type Socket } from "node:dgram";
 import { lookup } from "node:dns";
@@ -53,7 +61,9 @@ export function describeUdpError(
 }
 
 /** Datagrams kept while the sender connects (resolving a host name may take a while). */
-const MAX_PENDING = 256;
+export const MAX_PENDING = 256;
+/** After a failed lookup or connect, the next datagram tries again at most this often, s. */
+export const RESOLVE_RETRY_S = 5;
 
 function familyOf(host: string): "udp4" | "udp6" {
   return isIP(host) === 6 ? "udp6" : "udp4";
@@ -62,8 +72,13 @@ function familyOf(host: string): "udp4" | "udp6" {
 class NodeUdpSocket implements UdpSocketHandle {
   private readonly socket: Socket;
   private closed = false;
+  private bound = false;
   /** Connected to `remote` (sends go without an address). */
   private connected = false;
+  /** Why the last lookup or connect failed (datagrams are then dropped, one error each). */
+  private failure: string | undefined;
+  private failedAt = 0;
+  private readonly pending: Buffer[] = [];
 
   constructor(private readonly o: UdpOpenOptions) {
     const host = o.bind?.host ?? o.remote?.host ?? "127.0.0.1";
@@ -99,34 +114,44 @@ class NodeUdpSocket implements UdpSocketHandle {
     }
   }
 
-  private bound = false;
-
   private ready(): void {
     const a = this.socket.address();
     this.o.onReady?.({ host: a.address, port: a.port });
   }
 
-  /** Resolves the destination once, then connects (sends before that carry the address). */
+  /** One `onError` per datagram not sent. */
+  private lost(count: number, message: string): void {
+    for (let i = 0; i < count && !this.closed; i++) this.o.onError(message);
+  }
+
+  /** The lookup or connect failed: every datagram waiting is lost, and later ones until a retry. */
+  private fail(message: string): void {
+    this.failure = message;
+    this.failedAt = performance.now();
+    const queued = this.pending.splice(0);
+    this.lost(queued.length, message);
+  }
+
+  /** Resolves the destination once, then connects (sends before that wait in `pending`). */
   private connect(remote: Endpoint): void {
+    this.failure = undefined;
     const go = (ip: string): void => {
       if (this.closed) return;
-      this.socket.connect(remote.port, ip, (err?: Error) => {
-        if (this.closed) return;
-        if (err) {
-          this.o.onError(describeUdpError(err, "send", remote));
-          return;
-        }
-        this.connected = true;
-        this.ready();
-        const queued = this.pending.splice(0);
-        for (const b of queued) this.sendNow(b);
-        if (this.overflow > 0) {
-          this.o.onError(
-            `${this.overflow} datagrams dropped while connecting to ${show(remote)} (more than ${MAX_PENDING} waiting)`,
-          );
-          this.overflow = 0;
-        }
-      });
+      try {
+        this.socket.connect(remote.port, ip, (err?: Error) => {
+          if (this.closed) return;
+          if (err) {
+            this.fail(describeUdpError(err, "send", remote));
+            return;
+          }
+          this.connected = true;
+          this.ready();
+          const queued = this.pending.splice(0);
+          for (const b of queued) this.sendNow(b);
+        });
+      } catch (e) {
+        this.fail(describeUdpError(e, "send", remote));
+      }
     };
     if (isIP(remote.host) !== 0) {
       go(remote.host);
@@ -134,22 +159,27 @@ class NodeUdpSocket implements UdpSocketHandle {
     }
     lookup(remote.host, { family: 4 }, (err, address) => {
       if (this.closed) return;
-      if (err) this.o.onError(describeUdpError(err, "resolve", remote));
+      if (err) this.fail(describeUdpError(err, "resolve", remote));
       else go(address);
     });
   }
 
-  private readonly pending: Buffer[] = [];
-  private overflow = 0;
+  /** Completion of every send: a failed one is a datagram lost (Node reports it nowhere else). */
+  private readonly afterSend = (err: Error | null): void => {
+    if (err && !this.closed) {
+      this.o.onError(describeUdpError(err, "send", this.o.remote ?? { host: "?", port: 0 }));
+    }
+  };
 
   /**
-   * Sends without a completion callback: Node then tries the send at once and reports a failure
-   * as the socket's 'error' event (handled above), instead of scheduling a callback per datagram.
+   * Sends with a completion callback: libuv still writes the datagram at once when nothing waits
+   * before it (the callback only comes later, on the event loop), and a failure reaches
+   * `afterSend` instead of vanishing as it does without a callback.
    */
   private sendNow(buf: Buffer, to?: Endpoint): void {
     try {
-      if (to) this.socket.send(buf, to.port, to.host);
-      else this.socket.send(buf);
+      if (to) this.socket.send(buf, to.port, to.host, this.afterSend);
+      else this.socket.send(buf, this.afterSend);
     } catch (e) {
       this.o.onError(describeUdpError(e, "send", to ?? this.o.remote ?? { host: "?", port: 0 }));
     }
@@ -157,23 +187,42 @@ class NodeUdpSocket implements UdpSocketHandle {
 
   send(data: Uint8Array, to?: Endpoint): void {
     if (this.closed) return;
-    // A copy: the caller reuses `data`, and a send that cannot leave at once is queued.
-    const buf = Buffer.from(data);
     if (to) {
       if (this.connected) this.o.onError("send with an address on a connected socket");
-      else this.sendNow(buf, to);
-    } else if (this.connected) {
-      this.sendNow(buf);
-    } else if (this.o.remote) {
-      if (this.pending.length < MAX_PENDING) this.pending.push(buf);
-      else this.overflow++;
-    } else {
+      else this.sendNow(Buffer.from(data), to);
+      return;
+    }
+    if (this.connected) {
+      this.sendNow(Buffer.from(data));
+      return;
+    }
+    const remote = this.o.remote;
+    if (!remote) {
       this.o.onError("send without a destination (the socket was opened without `remote`)");
+      return;
+    }
+    if (this.failure !== undefined) {
+      if (performance.now() - this.failedAt < RESOLVE_RETRY_S * 1000) {
+        this.o.onError(this.failure);
+        return;
+      }
+      this.connect(remote); // try again; this datagram waits for the outcome
+    }
+    // A copy: the caller reuses `data`.
+    if (this.pending.length < MAX_PENDING) this.pending.push(Buffer.from(data));
+    else {
+      this.o.onError(
+        `datagram dropped: more than ${MAX_PENDING} waiting while connecting to ${show(remote)}`,
+      );
     }
   }
 
   close(): void {
     if (this.closed) return;
+    const queued = this.pending.splice(0);
+    if (queued.length > 0 && this.o.remote) {
+      this.lost(queued.length, `not sent: closed while connecting to ${show(this.o.remote)}`);
+    }
     this.closed = true;
     try {
       this.socket.close();

@@ -9,7 +9,7 @@ import {
 } from "../../engine";
 import { ACTUATION_SIZE, DOAS } from "../control/actuation";
 import { signalInput } from "../shared/inputs";
-import { plural, TextThrottle } from "../shared/text";
+import { formatCount, plural, TextThrottle } from "../shared/text";
 import {
   MAX_DATAGRAM_BYTES,
   MAX_STREAMLINED_VALUES,
@@ -232,8 +232,12 @@ export const UdpSender = defineBlock({
     "Subcategory. `Serializer` overrides the choice, and the status names the serializer in " +
     "use. Formats **f32** and **f64** send bare " +
     "little-endian vectors, for peers that expect plain arrays. Nothing is sent in the browser " +
-    "build (no sockets; the status says so); send errors (e.g. nothing listening) are counted " +
-    "and shown, never fatal. Several inputs (MOSAIC's sender subscribed to every input) are " +
+    "build (no sockets; the status says so). Every datagram that is not sent is counted and " +
+    "shown, never fatal: the status reads `N datagrams sent, M not sent (the last reason)` and a " +
+    "warning (at most every 2 s) gives the reason and the count so far — a host name that does " +
+    "not resolve (each datagram until a new lookup succeeds; retried every 5 s), the queue of " +
+    "the first milliseconds overflowing (256 datagrams wait while connecting), or a send that " +
+    "fails (nothing listening: ECONNREFUSED). Several inputs (MOSAIC's sender subscribed to every input) are " +
     "sent to the same destination, each with the serializer of its own source (MOSAIC chose " +
     "one from the first input for all, and its vector serializer sent nothing), one counter " +
     "for all datagrams; vector inputs get subcategory = their position in Inputs unless " +
@@ -284,7 +288,8 @@ export const UdpSender = defineBlock({
     const throttle = new TextThrottle();
 
     let socket: UdpSocketHandle | undefined;
-    let sent = 0;
+    /** Datagrams handed to the socket, and of those (or of datagrams that had no socket) not sent. */
+    let handed = 0;
     let failed = 0;
     let notSent = 0;
     let lastError = "";
@@ -296,18 +301,37 @@ export const UdpSender = defineBlock({
         );
         return;
       }
-      const err = failed > 0 ? `, ${failed} failed (${lastError})` : "";
-      ctx.setText(`→ ${dest} (${what}): ${plural(sent, "datagram")} sent${err}`);
+      const err = failed > 0 ? `, ${formatCount(failed)} not sent (${lastError})` : "";
+      ctx.setText(
+        `→ ${dest} (${what}): ${plural(Math.max(0, handed - failed), "datagram")} sent${err}`,
+      );
     };
     const bridge = udpBridge(ctx);
     if (bridge) describe();
     else unavailable = true;
 
+    // The bridge calls onError once per datagram it did not send (native-bridges/udp.ts), often
+    // many at once (a queue dropped when a name does not resolve): the text is rebuilt once after
+    // each burst, warnings are rate-limited and say how many datagrams are lost in all.
+    let describeQueued = false;
+    const describeSoon = (): void => {
+      if (describeQueued) return;
+      describeQueued = true;
+      queueMicrotask(() => {
+        describeQueued = false;
+        describe();
+      });
+    };
     const onError = (message: string): void => {
       failed++;
       lastError = message;
-      warns.warn(`UDP to ${dest}: ${message}`);
-      describe();
+      warns.warn(`UDP to ${dest}: ${message} (${plural(failed, "datagram")} not sent so far)`);
+      describeSoon();
+    };
+    /** Datagrams one event of input `port` makes. */
+    const perEvent = (port: number): number => {
+      const l = lanes[port]!;
+      return l.perValue ? l.size : 1;
     };
 
     const close = (): void => {
@@ -335,8 +359,15 @@ export const UdpSender = defineBlock({
         const s = socket;
         const n = f.n;
         if (!s) {
-          notSent += n;
-          if (unavailable && n > 0 && throttle.due(f.t[n - 1]!)) describe();
+          if (unavailable) notSent += n;
+          else if (n > 0) {
+            // Before start or after a socket that could not be opened: counted as not sent.
+            const d = n * perEvent(port);
+            handed += d;
+            failed += d;
+            lastError ||= "no socket";
+          }
+          if (n > 0 && throttle.due(f.t[n - 1]!)) describe();
           return;
         }
         const lane = lanes[port]!;
@@ -349,17 +380,17 @@ export const UdpSender = defineBlock({
           const off = e * stride;
           if (rEnc) {
             s.send(rEnc.encode(v, off, scale));
-            sent++;
+            handed++;
           } else if (lane.perValue) {
             const t = sendTime ? ctx.now() : f.t[e]!;
             for (let k = 0; k < size; k++) {
               s.send(sEnc!.encode(t, category, subs[k]!, v, off + k, scale));
-              sent++;
+              handed++;
             }
           } else {
             const t = sendTime ? ctx.now() : f.t[e]!;
             s.send(sEnc!.encode(t, category, subs[0]!, v, off, scale));
-            sent++;
+            handed++;
           }
         }
         if (sEnc) counter = sEnc.counter;
@@ -371,7 +402,7 @@ export const UdpSender = defineBlock({
       },
       reset() {
         counter = 0;
-        sent = 0;
+        handed = 0;
         failed = 0;
         notSent = 0;
         lastError = "";
