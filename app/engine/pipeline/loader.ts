@@ -47,6 +47,7 @@ import {
   type PipelineSettings,
 } from "./spec";
 import { checkWiring } from "./wiring";
+import { checkPaths } from "./paths";
 
 export * from "./spec";
 export { objectKeys } from "./params";
@@ -294,6 +295,7 @@ function loadParsed(
     .map((p) => scalarString(p.key))
     .filter((s): s is string => !!s);
   checkWiring(c, blocks, byName, allNames);
+  checkPaths(c, blocks, doc);
 
   if (blocks.length === 0 && c.errors === 0) {
     c.error("empty", { line: 1, col: 1 }, "the pipeline has no blocks");
