@@ -9,6 +9,7 @@ import {
 import { timerInput } from "../shared/inputs";
 import { index } from "../shared/params";
 import { TextThrottle } from "../shared/text";
+import { MAX_TIMER_HZ } from "../timing/scheduled-timer";
 import { parseDelimited, TIME_COLUMN_NAMES } from "./delimited-text";
 
 const columnRef = () => z.union([z.string().min(1), index()]);
@@ -154,6 +155,19 @@ export const FilePlayer = defineBlock({
           `the median interval between rows of '${p.File}' is 0 (repeated times); original ` +
             "timing needs increasing times",
           "TimeColumn",
+        );
+      }
+      const rowHz = p.Speed / median;
+      if (rowHz > MAX_TIMER_HZ) {
+        const fileHz = Number((1 / median).toPrecision(6));
+        throw new BlockConfigError(
+          p.Speed !== 1
+            ? `at Speed ${p.Speed} the rows of '${p.File}' (${fileHz} Hz) would play at ` +
+                `${Number(rowHz.toPrecision(6))} Hz, above the fastest the engine paces, ` +
+                `${MAX_TIMER_HZ} Hz: lower Speed`
+            : `the rows of '${p.File}' come at ${fileHz} Hz, above the fastest the engine paces, ` +
+                `${MAX_TIMER_HZ} Hz: play it with a timer input (one row per tick) or resample it`,
+          p.Speed !== 1 ? "Speed" : "File",
         );
       }
       span = times[rows - 1]! - times[0]! + median;

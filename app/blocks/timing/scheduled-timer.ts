@@ -1,5 +1,15 @@
 import { z } from "zod";
-import { defineBlock, EMPTY_SHAPE } from "../../engine";
+import { BlockConfigError, defineBlock, EMPTY_SHAPE } from "../../engine";
+
+/**
+ * The fastest a timer is paced at, Hz. The lossless, batched scheduler keeps a timer → Sink on
+ * time at 4 MHz on the 2-core build VM (5 ms batching interval; 200 kHz: 0.5 % of a core in the
+ * blocks), but every tick is an event that each block after it handles, logs and sends: 100 kHz
+ * leaves that work ~40× the room, and is 3× the fastest acquisition devices' rates (30 kHz
+ * amplifiers; EMG at 1–4 kHz). Faster sources deliver packets: a vector of samples per tick
+ * (MuoviSingleProbe's form).
+ */
+export const MAX_TIMER_HZ = 100_000;
 
 export const ScheduledTimer = defineBlock({
   type: "ScheduledTimer",
@@ -12,8 +22,9 @@ export const ScheduledTimer = defineBlock({
     "a device delivers a packet of samples. The worker wakes at most once per batching interval " +
     "(`BatchingMs`, default 5 ms; 0 wakes for every tick). `CatchUp: skip` is for control-rate " +
     "timers whose stale ticks are worthless: after a stall only the newest tick goes out and " +
-    "the others are counted as missed. Ticks carry no values. Right-click actions start and stop " +
-    "it; with `Autostart: false` it waits for the start action.",
+    "the others are counted as missed (the block then reads lagging, for as long as the skipped " +
+    "ticks span, at least 100 ms). Ticks carry no values. DesiredRate is at most 100 kHz. " +
+    "Right-click actions start and stop it; with `Autostart: false` it waits for the start action.",
   params: z.strictObject({
     Autostart: z.boolean().default(true).describe("Start ticking when the pipeline starts"),
     CatchUp: z
@@ -31,6 +42,14 @@ export const ScheduledTimer = defineBlock({
   views: ["label"],
   panel: "Actual rate, ticks fired and missed, lateness percentiles; start/stop buttons.",
   create(ctx, p) {
+    if (ctx.desiredRate > MAX_TIMER_HZ) {
+      throw new BlockConfigError(
+        `DesiredRate ${ctx.desiredRate} Hz is above the fastest a timer is paced at, ` +
+          `${MAX_TIMER_HZ} Hz: every tick is an event for every block after it; for faster ` +
+          "signals send packets (a vector of samples per tick) at a lower rate",
+        "DesiredRate",
+      );
+    }
     const out = ctx.output(EMPTY_SHAPE);
     const timer = ctx.every(
       ctx.desiredRate,

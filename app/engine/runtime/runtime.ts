@@ -869,6 +869,7 @@ export class Runtime {
     if (!node || !node.started) return;
     const t0 = performance.now();
     if (e.period > 0 && !this.virtual) node.status.delivered(e.times[0]!, this.clock.now());
+    if (e.missed > 0) node.status.missed(e.missed, this.clock.now());
     try {
       if (e.period > 0) e.onTicks(e.times, n);
       else e.cb(e.times[0]!);

@@ -7,7 +7,8 @@
  *   late: its oldest event waited longer than max(2 periods, 50 ms) plus the batching interval
  *   (the engine is behind real time; lossless timers keep rates exact, so a rate alone would not
  *   show it). A late batch keeps the block red for as long as it was delayed, at least LATE_HOLD_S,
- *   whatever the block's rate;
+ *   whatever the block's rate; so do ticks a `CatchUp: skip` timer skipped (for as long as they
+ *   span): a timer that misses ticks is never green;
  * - stumbling (magenta) when one `process` call (measured) took longer than the time its events
  *   span, max(1, n) / DesiredRate, within the current window;
  * - on time (green) otherwise. Precedence idle > lagging > stumbling > on time.
@@ -134,6 +135,22 @@ export class StatusTracker {
     if (d > this.delayMaxWindow) this.delayMaxWindow = d;
     if (d > this.lateAfter())
       this.lateUntil = Math.max(this.lateUntil, now + Math.max(d, LATE_HOLD_S));
+  }
+
+  /** Ticks the block's `CatchUp: skip` timer has skipped so far (see `missed`). */
+  missedTicks = 0;
+
+  /**
+   * A timer that skipped ticks (`CatchUp: skip`) is behind like a late batch: given the timer's
+   * count of skipped ticks so far at clock time `now`, the block reads lagging for as long as the
+   * newly skipped ticks span, at least LATE_HOLD_S.
+   */
+  missed(total: number, now: number): void {
+    const n = total - this.missedTicks;
+    if (n <= 0) return;
+    this.missedTicks = total;
+    const r = this.desiredRate;
+    this.lateUntil = Math.max(this.lateUntil, now + Math.max(r > 0 ? n / r : 0, LATE_HOLD_S));
   }
 
   /** The delivery delay above which a batch is late (the block reads as lagging), s. */
