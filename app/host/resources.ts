@@ -1,6 +1,6 @@
 import { realpathSync } from "node:fs";
 import { mkdir, readFile, rename, rm, writeFile } from "node:fs/promises";
-import { basename, dirname, isAbsolute, relative, resolve } from "node:path";
+import { basename, dirname, isAbsolute, relative, resolve, sep } from "node:path";
 import type { Resources } from "../engine/block";
 
 /**
@@ -101,7 +101,9 @@ export class AllowedFolders {
     const real = onDisk(full);
     for (const root of this.real) {
       const rel = relative(root, real);
-      if (rel === "" || (!rel.startsWith("..") && !isAbsolute(rel))) return undefined;
+      if (rel === "" || (rel !== ".." && !rel.startsWith(`..${sep}`) && !isAbsolute(rel))) {
+        return undefined;
+      }
     }
     return (
       `${full} is outside the folders this pipeline may ${what} (${this.dirs.join(", ")}): a ` +

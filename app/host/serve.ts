@@ -10,9 +10,10 @@
  *
  * Slow clients: what waits on a client's socket (`ws`'s `bufferedAmount`) is bounded. Above
  * `dropAboveBytes` its telemetry (replaced 20 times a second), panel data and events are dropped
- * and counted; a client whose waiting bytes have not gone down for `stalledMs`, or that has more
- * than `maxBufferedBytes` waiting, is disconnected (close code 1008 and the reason), and its
- * socket destroyed `closeGraceMs` later if it does not read the close.
+ * and counted; a client that sends none of what waits for `stalledMs`, or that has more than
+ * `maxBufferedBytes` waiting and sent none of it since the last look (every 0.5 s), is
+ * disconnected (close code 1008 and the reason), and its socket destroyed `closeGraceMs` later if
+ * it does not read the close. A client that is receiving (a large graph on its way) stays.
  */
 import { randomBytes, timingSafeEqual } from "node:crypto";
 import type { IncomingMessage } from "node:http";
@@ -26,9 +27,9 @@ import { serveStatic, type WebServer } from "./web-server";
 export interface SlowClientLimits {
   /** Bytes waiting on a client's socket above which its telemetry, data and events are dropped. */
   dropAboveBytes: number;
-  /** Bytes waiting above which the client is disconnected at once. */
+  /** Bytes waiting above which a client that sent nothing since the last look goes at once. */
   maxBufferedBytes: number;
-  /** A client with more than `dropAboveBytes` waiting that read none of it for this long goes. */
+  /** A client with more than `dropAboveBytes` waiting that sent none of it for this long goes. */
   stalledMs: number;
   /** How long a disconnected client has to read the close frame before its socket is destroyed. */
   closeGraceMs: number;
@@ -140,14 +141,15 @@ export async function serve(o: ServeOptions): Promise<Served> {
   });
 
   // The hub hands the same message object to every client: encode it once, not once per tab.
-  const encoded = new WeakMap<object, string>();
-  const encode = (msg: object): string => {
-    let text = encoded.get(msg);
-    if (text === undefined) {
-      text = encodeWire(msg);
-      encoded.set(msg, text);
+  const encoded = new WeakMap<object, { text: string; bytes: number }>();
+  const encode = (msg: object): { text: string; bytes: number } => {
+    let e = encoded.get(msg);
+    if (e === undefined) {
+      const text = encodeWire(msg);
+      e = { text, bytes: Buffer.byteLength(text) };
+      encoded.set(msg, e);
     }
-    return text;
+    return e;
   };
 
   const limits: SlowClientLimits = { ...SLOW_CLIENT_LIMITS, ...o.slowClients };
@@ -156,12 +158,19 @@ export async function serve(o: ServeOptions): Promise<Served> {
     dropped: { telemetry: 0, data: 0, event: 0 },
     disconnected: [],
   };
-  /** Per socket: the bytes it had waiting at the last look, and since when none were read. */
-  const watch = new Map<WebSocket, { last: number; since: number | undefined; left: boolean }>();
+  /**
+   * Per socket: bytes handed to it, bytes it had sent at the last look (handed − waiting), when
+   * it last sent any while bytes waited, and whether it is being disconnected.
+   */
+  interface Watched {
+    queued: number;
+    sent: number;
+    progressAt: number;
+    left: boolean;
+  }
+  const watch = new Map<WebSocket, Watched>();
 
-  const disconnect = (ws: WebSocket, reason: string): void => {
-    const w = watch.get(ws);
-    if (!w || w.left) return;
+  const disconnect = (ws: WebSocket, w: Watched, reason: string): void => {
     w.left = true;
     stats.disconnected.push(reason);
     o.onProblem?.(`a client was disconnected: ${reason}`);
@@ -169,40 +178,41 @@ export async function serve(o: ServeOptions): Promise<Served> {
     setTimeout(() => ws.terminate(), limits.closeGraceMs).unref();
   };
 
-  /** False when the client is gone or was just disconnected. */
-  const keep = (ws: WebSocket, now: number): boolean => {
-    const w = watch.get(ws);
-    if (!w || w.left) return false;
+  /**
+   * Looks at one client: it goes when more than `maxBufferedBytes` wait and nothing was sent
+   * since the last look, or when more than `dropAboveBytes` have waited with nothing sent for
+   * `stalledMs`. (A client that is sending — a large graph on its way — stays.)
+   */
+  const look = (ws: WebSocket, w: Watched, now: number): void => {
+    if (w.left) return;
     const waiting = ws.bufferedAmount;
+    const sent = w.queued - waiting;
+    const progressed = sent > w.sent;
+    w.sent = sent;
+    if (progressed || waiting <= limits.dropAboveBytes) w.progressAt = now;
     const mib = (waiting / (1024 * 1024)).toFixed(1);
-    if (waiting > limits.maxBufferedBytes) {
-      disconnect(ws, `too slow: ${mib} MiB waiting to be sent`);
-      return false;
+    if (waiting > limits.maxBufferedBytes && !progressed) {
+      disconnect(ws, w, `too slow: ${mib} MiB waiting to be sent`);
+    } else if (now - w.progressAt >= limits.stalledMs) {
+      disconnect(ws, w, `stalled: read nothing of ${mib} MiB for ${limits.stalledMs / 1000} s`);
     }
-    if (waiting <= limits.dropAboveBytes || waiting < w.last) w.since = undefined;
-    else w.since ??= now;
-    w.last = waiting;
-    if (w.since !== undefined && now - w.since >= limits.stalledMs) {
-      disconnect(ws, `stalled: read nothing of ${mib} MiB for ${limits.stalledMs / 1000} s`);
-      return false;
-    }
-    return true;
   };
   const sweep = setInterval(
     () => {
       const now = Date.now();
-      for (const ws of watch.keys()) keep(ws, now);
+      for (const [ws, w] of watch) look(ws, w, now);
     },
     Math.min(500, limits.stalledMs / 4),
   );
   sweep.unref();
 
   const attach = (ws: WebSocket): void => {
-    watch.set(ws, { last: 0, since: undefined, left: false });
+    const w: Watched = { queued: 0, sent: 0, progressAt: Date.now(), left: false };
+    watch.set(ws, w);
     stats.clients++;
     const conn = hub.connect({
       send(msg) {
-        if (ws.readyState !== ws.OPEN || !keep(ws, Date.now())) return;
+        if (ws.readyState !== ws.OPEN || w.left) return;
         // Telemetry (replaced 20 times a second), panel data and events are best effort: a tab
         // that cannot keep up (hidden, slow, stalled) skips them rather than queueing them.
         if (
@@ -212,7 +222,9 @@ export async function serve(o: ServeOptions): Promise<Served> {
           stats.dropped[msg.type]++;
           return;
         }
-        ws.send(encode(msg));
+        const e = encode(msg);
+        w.queued += e.bytes;
+        ws.send(e.text);
       },
     });
     ws.on("message", (data, isBinary) => {

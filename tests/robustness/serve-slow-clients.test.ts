@@ -13,7 +13,7 @@ import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { afterAll, beforeAll, describe, expect, test } from "vitest";
 import WebSocket from "ws";
-import { decodeWire } from "../../app/engine/protocol-wire";
+import { decodeWire, encodeWire } from "../../app/engine/protocol-wire";
 import { CLOSE_TOO_SLOW, serve, type Served } from "../../app/host/serve";
 import { requireBuild, ROOT } from "../integration/helpers";
 
@@ -210,5 +210,36 @@ describe("clients that stop reading", () => {
     raw.sock.resume();
     await until(() => raw.closed !== undefined || raw.ended);
     expect(raw.closed?.code).toBe(CLOSE_TOO_SLOW);
+  }, 60_000);
+
+  test("a reading client that is sent more than maxBufferedBytes at once (a large graph) stays", async () => {
+    const before = served.stats();
+    const good = await reader();
+    const replies: { id: number; ok: boolean }[] = [];
+    good.ws.on("message", (d) => {
+      const m = decodeWire(String(d)) as { type: string; id: number; ok: boolean };
+      if (m.type === "reply") replies.push(m);
+    });
+    const lines = [
+      "T: { Type: ScheduledTimer, DesiredRate: 10 }",
+      "E: { Type: EmgSimulator, Inputs: [T], Params: { Channels: 2 } }",
+    ];
+    for (let i = 1; i < 6000; i++)
+      lines.push(
+        `F${i}: { Type: Filter, Inputs: [${i === 1 ? "E" : `F${i - 1}`}], Params: { Numerator: [1, 2, 3], Denominator: [1] } }`,
+      );
+    const sent = encodeWire({
+      type: "load",
+      id: 1,
+      file: "pipelines/big.yaml",
+      source: lines.join("\n"),
+    });
+    good.ws.send(sent);
+    await until(() => replies.some((r) => r.id === 1), 30_000);
+    expect(replies.find((r) => r.id === 1)!.ok).toBe(true);
+    await new Promise((r) => setTimeout(r, LIMITS.stalledMs));
+    expect(good.ws.readyState).toBe(WebSocket.OPEN);
+    expect(served.stats().disconnected).toEqual(before.disconnected);
+    good.ws.close();
   }, 60_000);
 });
