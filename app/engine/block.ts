@@ -65,6 +65,12 @@ export interface Resources {
    * Not for streams: use `ctx.openLog` for data that keeps coming.
    */
   writeText(path: string, text: string): Promise<void>;
+  /**
+   * True when the pipeline came from a client of `mosaic serve` or the desktop app's window:
+   * reads and writes are confined to allowed folders, and blocks must not reach code or files
+   * outside them by other means (e.g. a Python block importing an installed module by name).
+   */
+  readonly confined?: boolean;
 }
 
 export interface TimerHandle {

@@ -125,6 +125,7 @@ export function nodeResources(baseDir: string, allowed?: AllowedFolders): Resour
     return full;
   };
   return {
+    confined: allowed !== undefined,
     resolve: (p: string) => confine(p, "use"),
     readText: async (p: string) => {
       const full = confine(p, "read");

@@ -122,6 +122,31 @@ describe("Python block (fake sidecar)", () => {
     expect(b2.options.module).toBe("sklearn.decomposition");
   });
 
+  test("confined (a pipeline from a serve or desktop client): installed modules by name are refused", async () => {
+    const confined = (Module: string) =>
+      BlockHarness.create(
+        Python,
+        { Module, Function: "system", Init: "system", Params: { cmd: "touch /tmp/x" } },
+        {
+          inputs: [{ shape: vectorShape(2), rate: 100 }],
+          io: { python: manualBridge().bridge },
+          virtual: false,
+          resources: {
+            resolve: (p) => `/pipelines/${p}`,
+            readText: () => Promise.reject(new Error("no")),
+            writeText: () => Promise.resolve(),
+            confined: true,
+          },
+        },
+      );
+    await expect(confined("os")).rejects.toThrow(
+      /Module 'os' is an installed module name; a pipeline loaded by a client of mosaic serve or the desktop app may run only Python files in its own folder/,
+    );
+    // Its own files, and the sidecar's shipped modules (the Python-backed blocks), still load.
+    await expect(confined("model.py")).resolves.toBeDefined();
+    await expect(confined("mosaic_blocks.learning")).resolves.toBeDefined();
+  });
+
   test("results are emitted with the input's timestamp; one call in flight, the newest input waits", async () => {
     const { h, b } = await harness({});
     h.push(ev(1, 1, 1));

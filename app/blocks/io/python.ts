@@ -4,6 +4,7 @@ import {
   defineBlock,
   formatShape,
   shapeSize,
+  type BlockContext,
   type Frame,
   type PythonCallError,
   type PythonSidecar,
@@ -96,6 +97,26 @@ function paramOf(kind: string, p: Params): string {
     default:
       return "Module";
   }
+}
+
+/** The sidecar's own modules, which the Python-backed blocks (app/blocks/learning, …) load. */
+const SHIPPED_MODULES = "mosaic_blocks.";
+
+/**
+ * A pipeline from a client of `mosaic serve` or the desktop app (confined resources) may run
+ * only code in its allowed folders and the sidecar's own modules: an installed module by name
+ * (`os` with Init `system`) would run anything on the host.
+ */
+function refuseInstalledModule(ctx: BlockContext, module: string): void {
+  if (!ctx.resources.confined || looksLikeFile(module) || module.startsWith(SHIPPED_MODULES)) {
+    return;
+  }
+  throw new BlockConfigError(
+    `Module '${module}' is an installed module name; a pipeline loaded by a client of mosaic ` +
+      "serve or the desktop app may run only Python files in its own folder or the data folder " +
+      "(write it as a file name, e.g. Module: mymodel.py)",
+    "Module",
+  );
 }
 
 const looksLikeFile = (m: string): boolean =>
@@ -458,6 +479,7 @@ export const Python = defineBlock({
       refresh(true);
     };
 
+    refuseInstalledModule(ctx, p.Module);
     let loadPromise: Promise<PythonSidecar>;
     try {
       loadPromise = bridge.load({
