@@ -54,6 +54,8 @@ export interface SimulationEnv {
   freshName(base: string): string;
   /** True when some block reads the output port `port` of `block`. */
   consumed(block: string, port?: string): boolean;
+  /** The pipeline's blocks of one type, in file order (indexed once: no scan per device). */
+  ofType(type: string): readonly BlockSpec[];
   readonly keepNetwork: boolean;
 }
 
@@ -315,7 +317,7 @@ export const SIMULATED_DEVICES: Readonly<Record<string, DeviceRule>> = {
       const where = `${String(q.Url)} ${String(q.Topic)}`;
       if (q.Direction === "publish") return sink(b, where, "message");
       const channels = (q.Channels as number | undefined) ?? 1;
-      const publisher = env.spec.blocks.find((o) => {
+      const publisher = env.ofType("ROS").find((o) => {
         const r = p(o);
         return (
           o.type === "ROS" &&
@@ -387,13 +389,14 @@ export const SIMULATED_DEVICES: Readonly<Record<string, DeviceRule>> = {
       "SimulatedOutput (datagrams); kept when a UdpReceiver of the same pipeline listens on its port",
     substitute(b, env) {
       const q = p(b);
-      const self = env.spec.blocks.find(
-        (o) =>
-          o.type === "UdpReceiver" &&
-          p(o).Port === q.Port &&
-          LOOPBACK.test(String(q.Host)) &&
-          (LOOPBACK.test(String(p(o).Host)) || p(o).Host === q.Host),
-      );
+      const self = env
+        .ofType("UdpReceiver")
+        .find(
+          (o) =>
+            p(o).Port === q.Port &&
+            LOOPBACK.test(String(q.Host)) &&
+            (LOOPBACK.test(String(p(o).Host)) || p(o).Host === q.Host),
+        );
       if (self) return `its datagrams go to ${self.name}, a UdpReceiver of this pipeline`;
       // The control serializer sends one datagram per value (per input, as the sender chooses).
       const counts = b.inputs.map((i) =>
@@ -441,6 +444,7 @@ export function simulateDevices(
 ): SimulationResult {
   const keepNetwork = options.keepNetwork === true;
   const names = new Set(spec.blocks.map((b) => b.name));
+  const { read, byType } = indexOf(spec);
   const env: SimulationEnv = {
     spec,
     keepNetwork,
@@ -451,10 +455,8 @@ export function simulateDevices(
       names.add(n);
       return n;
     },
-    consumed: (block, port) =>
-      spec.blocks.some((o) =>
-        o.inputs.some((i) => i.block === block && (port === undefined || i.port === port)),
-      ),
+    consumed: (block, port) => read.has(port === undefined ? block : `${block}.${port}`),
+    ofType: (type) => byType.get(type) ?? [],
   };
   const diagnostics: Diagnostic[] = [];
   const substituted: string[] = [];
@@ -570,4 +572,23 @@ export function withSimulatedDevices(
   if (!options || !loaded.spec) return loaded;
   const s = simulateDevices(loaded.spec, catalog, options);
   return { ...loaded, spec: s.spec, diagnostics: [...loaded.diagnostics, ...s.diagnostics] };
+}
+
+/** What the pipeline's inputs read ("Block" and "Block.port") and its blocks by type. */
+function indexOf(spec: PipelineSpec): {
+  read: Set<string>;
+  byType: Map<string, BlockSpec[]>;
+} {
+  const read = new Set<string>();
+  const byType = new Map<string, BlockSpec[]>();
+  for (const b of spec.blocks) {
+    for (const i of b.inputs) {
+      read.add(i.block);
+      read.add(`${i.block}.${i.port}`);
+    }
+    const list = byType.get(b.type);
+    if (list) list.push(b);
+    else byType.set(b.type, [b]);
+  }
+  return { read, byType };
 }
