@@ -9,6 +9,7 @@ import {
 import { vectorInput } from "../shared/inputs";
 import { extendedNumber } from "../shared/params";
 import { A, DOAS } from "./actuation";
+import { MAX_ITEMS } from "../shared/limits";
 
 /**
  * Strategies behind one interface (paper III-H): both turn one prediction vector into the next
@@ -109,6 +110,7 @@ const params = z
     DoFs: z
       .array(dof)
       .min(1)
+      .max(MAX_ITEMS)
       .optional()
       .describe(
         "Degrees of freedom and the predictions that drive them; default: one DoF per prediction (DoF k driven by prediction k)",
@@ -145,7 +147,7 @@ const params = z
         "Watchdog: seconds without a prediction before the safe output is sent (0 = off); it needs DesiredRate or a periodic input",
       ),
     Safe: z
-      .union([z.enum(["rest", "hold"]), z.array(z.number())])
+      .union([z.enum(["rest", "hold"]), z.array(z.number()).max(MAX_ITEMS)])
       .default("rest")
       .describe(
         "What the watchdog sends when predictions stop: each DoF's Rest, its last value (hold), or these values",

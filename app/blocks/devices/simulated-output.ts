@@ -1,6 +1,7 @@
 import { z } from "zod";
 import { defineBlock, shapeSize } from "../../engine";
 import { plural, TextThrottle } from "../shared/text";
+import { MAX_ITEMS } from "../shared/limits";
 
 const COUNTS = ["events", "values"] as const;
 
@@ -31,7 +32,7 @@ export const SimulatedOutput = defineBlock({
       .default("event")
       .describe("What the device block sends, for the status text"),
     Count: z
-      .union([z.enum(COUNTS), z.array(z.enum(COUNTS)).min(1)])
+      .union([z.enum(COUNTS), z.array(z.enum(COUNTS)).min(1).max(MAX_ITEMS)])
       .default("events")
       .describe(
         "events: one unit per input event; values: one per value of each event; a list: one of " +

@@ -2,6 +2,7 @@ import { z } from "zod";
 import { defineBlock } from "../../engine";
 import type { FeatureRequest } from "../../engine/dsp";
 import { createFeatureBlock, INPUT_HELP, REFERENCES, windowParams } from "./feature-block";
+import { MAX_ITEMS } from "../shared/limits";
 
 const FEATURES = ["MAV", "RMS", "WL", "ZC", "SSC", "VAR", "IAV", "DASDV", "WAMP"] as const;
 
@@ -10,6 +11,7 @@ const params = z
     Features: z
       .array(z.enum(FEATURES))
       .min(1)
+      .max(MAX_ITEMS)
       .default(["MAV", "ZC", "SSC", "WL"])
       .describe(
         "Features to compute, in output order (default [MAV, ZC, SSC, WL]: LibEMG's HTD set, " +

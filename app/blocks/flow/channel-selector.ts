@@ -3,6 +3,7 @@ import { defineBlock } from "../../engine";
 import { indexListArg } from "../shared/args";
 import { checkIndices, inputName, signalInput } from "../shared/inputs";
 import { index } from "../shared/params";
+import { MAX_CHANNELS } from "../shared/limits";
 
 const MODES = ["zero", "hold", "nan"] as const;
 type Mode = (typeof MODES)[number];
@@ -27,6 +28,7 @@ export const ChannelSelector = defineBlock({
   params: z.strictObject({
     Active: z
       .array(index())
+      .max(MAX_CHANNELS)
       .optional()
       .describe(
         "0-based channels that pass (default: all; [] passes none); can be changed while running",

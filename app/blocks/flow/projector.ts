@@ -2,6 +2,7 @@ import { z } from "zod";
 import { defineBlock, LegacyParamsError, legacyVector, matrixShape } from "../../engine";
 import { checkIndices, inputName, signalInput } from "../shared/inputs";
 import { index } from "../shared/params";
+import { MAX_CHANNELS } from "../shared/limits";
 
 export const Projector = defineBlock({
   type: "Projector",
@@ -16,6 +17,7 @@ export const Projector = defineBlock({
     Indices: z
       .array(index())
       .min(1)
+      .max(MAX_CHANNELS)
       .describe(
         "0-based input indices, in output order (may repeat or reorder), e.g. [4, 5, 6, 0]",
       ),

@@ -2,6 +2,7 @@ import { z } from "zod";
 import { BlockConfigError, defineBlock, formatShape, matrixShape } from "../../engine";
 import { checkIndices, inputName, signalInput } from "../shared/inputs";
 import { index } from "../shared/params";
+import { MAX_CHANNELS } from "../shared/limits";
 
 export const Selector = defineBlock({
   type: "Selector",
@@ -30,6 +31,7 @@ export const Selector = defineBlock({
     Columns: z
       .array(index())
       .min(1)
+      .max(MAX_CHANNELS)
       .optional()
       .describe("Keep only these 0-based columns, in this order (default: all)"),
   }),

@@ -8,6 +8,7 @@ import {
   type OutputPort,
 } from "../../engine";
 import { checkIndices, inputName, vectorInput } from "../shared/inputs";
+import { MAX_CHANNELS, MAX_ITEMS } from "../shared/limits";
 import { index } from "../shared/params";
 
 const PORT_RE = /^[A-Za-z0-9_-]+$/;
@@ -17,8 +18,11 @@ const params = z
     Parts: z
       .record(
         z.string().regex(PORT_RE, "a port name uses only letters, digits, '_' and '-'"),
-        z.array(index()).min(1),
+        z.array(index()).min(1).max(MAX_CHANNELS),
       )
+      .refine((parts) => Object.keys(parts).length <= MAX_ITEMS, {
+        message: `at most ${MAX_ITEMS} ports`,
+      })
       .optional()
       .describe(
         "Output ports by name, each with the 0-based input indices it carries, e.g. " +
@@ -27,6 +31,7 @@ const params = z
     Sizes: z
       .array(z.number().int().min(1))
       .min(1)
+      .max(MAX_ITEMS)
       .optional()
       .describe(
         "Consecutive part sizes, e.g. [4, 4] splits 8 channels into ports `0` (0–3) and `1` " +

@@ -4,6 +4,7 @@
  * row-major `Float64Array`s.
  */
 import { z } from "zod";
+import { MAX_CHANNELS, MAX_ITEMS } from "./limits";
 
 /**
  * The rotation R = Rz(yaw) · Ry(pitch) · Rx(roll) (angles in radians, right-handed, applied to
@@ -32,8 +33,9 @@ export function rotationRPY(roll: number, pitch: number, yaw: number, out: Float
 /** A matrix param: a list of rows, every row the same length. */
 export const matrixParam = () =>
   z
-    .array(z.array(z.number()).min(1))
+    .array(z.array(z.number()).min(1).max(MAX_CHANNELS))
     .min(1)
+    .max(MAX_ITEMS)
     .refine((m) => m.every((r) => r.length === m[0]!.length), {
       message: "every row of the matrix must have the same length",
     });

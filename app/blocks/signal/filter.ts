@@ -9,6 +9,7 @@ import {
 import { FilterBank } from "../../engine/dsp";
 import { requireDsp } from "../shared/dsp";
 import { signalInput } from "../shared/inputs";
+import { MAX_COEFFICIENTS } from "../shared/limits";
 
 export const Filter = defineBlock({
   type: "Filter",
@@ -27,10 +28,12 @@ export const Filter = defineBlock({
       Numerator: z
         .array(z.number())
         .min(1)
+        .max(MAX_COEFFICIENTS)
         .describe("Feedforward coefficients m_0 … m_P (SciPy's b)"),
       Denominator: z
         .array(z.number())
         .min(1)
+        .max(MAX_COEFFICIENTS)
         .default([1])
         .describe("Feedback coefficients 1, d_1 … d_Q (SciPy's a); [1] gives an FIR filter"),
     })

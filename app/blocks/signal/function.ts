@@ -14,6 +14,7 @@ import { FunctionKernel, type FunctionOperation } from "../../engine/dsp";
 import { requireDsp } from "../shared/dsp";
 import { inputName, signalInput } from "../shared/inputs";
 import { extendedNumber } from "../shared/params";
+import { MAX_CHANNELS } from "../shared/limits";
 
 const OPERATIONS = ["add", "multiply", "abs", "power", "clip"] as const;
 
@@ -26,7 +27,7 @@ const params = z
           "[Min, Max]",
       ),
     Value: z
-      .union([z.number(), z.array(z.number()).min(1)])
+      .union([z.number(), z.array(z.number()).min(1).max(MAX_CHANNELS)])
       .optional()
       .describe(
         "Operand of add and multiply: one number for every element, or one per channel (the " +

@@ -2,6 +2,7 @@ import { z } from "zod";
 import { BlockConfigError, defineBlock, vectorShape } from "../../engine";
 import { inputName, vectorInput } from "../shared/inputs";
 import { SeededRandom } from "../shared/random";
+import { MAX_CHANNELS, MAX_ITEMS } from "../shared/limits";
 
 export const LinearMap = defineBlock({
   type: "LinearMap",
@@ -24,14 +25,20 @@ export const LinearMap = defineBlock({
         .optional()
         .describe("Number of outputs k (default: the number of rows of Weights)"),
       Weights: z
-        .array(z.array(z.number()).min(1))
+        .array(z.array(z.number()).min(1).max(MAX_CHANNELS))
         .min(1)
+        .max(MAX_ITEMS)
         .optional()
         .describe(
           "The k × C matrix W as a list of k rows of C numbers (C = input width); default: " +
             "seeded random entries N(0, 1)/√C",
         ),
-      Bias: z.array(z.number()).min(1).optional().describe("The k offsets b (default: zeros)"),
+      Bias: z
+        .array(z.number())
+        .min(1)
+        .max(MAX_ITEMS)
+        .optional()
+        .describe("The k offsets b (default: zeros)"),
       Seed: z
         .number()
         .int()

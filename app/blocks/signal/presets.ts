@@ -8,6 +8,7 @@ import { z } from "zod";
 import { BlockConfigError, defineBlock, formatShape, type Shape } from "../../engine";
 import { inputName, signalInput } from "../shared/inputs";
 import { FunctionBlock } from "./function";
+import { MAX_CHANNELS } from "../shared/limits";
 
 /** Widths a Function operand accepts for an input shape: 1, one per column, or one per element. */
 const gainFits = (g: number | readonly number[], shape: Shape): boolean => {
@@ -15,7 +16,7 @@ const gainFits = (g: number | readonly number[], shape: Shape): boolean => {
   return len === 1 || len === shape.cols || len === shape.rows * shape.cols;
 };
 
-const gainSchema = z.union([z.number(), z.array(z.number()).min(1)]);
+const gainSchema = z.union([z.number(), z.array(z.number()).min(1).max(MAX_CHANNELS)]);
 
 export const Amplification = defineBlock({
   type: "Amplification",

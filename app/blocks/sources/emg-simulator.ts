@@ -3,6 +3,7 @@ import { BlockConfigError, closest, defineBlock, errorMessage, vectorShape } fro
 import { EmgSynth } from "../../engine/dsp";
 import { requireDsp } from "../shared/dsp";
 import { inputName, timerInput, vectorInput } from "../shared/inputs";
+import { MAX_ITEMS, MAX_SEQUENCE } from "../shared/limits";
 
 /** Names of the default gesture set, in output (one-hot) order. */
 export const DEFAULT_GESTURES = [
@@ -82,7 +83,10 @@ const params = z
       .default("rest")
       .describe("Gesture held from the start (ignored while a Sequence plays)"),
     Gestures: z
-      .record(z.string().min(1), z.array(z.number().min(0).max(1)).min(1))
+      .record(z.string().min(1), z.array(z.number().min(0).max(1)).min(1).max(4096))
+      .refine((g) => Object.keys(g).length <= MAX_ITEMS, {
+        message: `at most ${MAX_ITEMS} gestures`,
+      })
       .optional()
       .describe(
         "Gestures by name, each a per-channel activation vector of Channels values from 0 " +
@@ -97,6 +101,7 @@ const params = z
         }),
       )
       .min(1)
+      .max(MAX_SEQUENCE)
       .optional()
       .describe(
         "Gestures played one after the other from the pipeline start and cycled, e.g. " +
@@ -105,6 +110,7 @@ const params = z
     CueGestures: z
       .array(z.string().min(1))
       .min(1)
+      .max(MAX_ITEMS)
       .optional()
       .describe(
         "With cue inputs: the gesture that each value of a cue event stands for, e.g. [fist, " +

@@ -11,6 +11,7 @@ import { index } from "../shared/params";
 import { TextThrottle } from "../shared/text";
 import { MAX_TIMER_HZ } from "../timing/scheduled-timer";
 import { parseDelimited, TIME_COLUMN_NAMES } from "./delimited-text";
+import { MAX_CHANNELS } from "../shared/limits";
 
 const columnRef = () => z.union([z.string().min(1), index()]);
 /** Most rows one wake-up of a self-timed player waits for (a batching interval rarely holds more). */
@@ -44,6 +45,7 @@ export const FilePlayer = defineBlock({
     Columns: z
       .array(columnRef())
       .min(1)
+      .max(MAX_CHANNELS)
       .optional()
       .describe(
         "Columns to play, in output order: header names or 0-based indices (default: every " +
