@@ -71,6 +71,23 @@ export interface Resources {
    * outside them by other means (e.g. a Python block importing an installed module by name).
    */
   readonly confined?: boolean;
+  /**
+   * Opens a file to read in pieces, synchronously (a big recording read as it plays); where the
+   * host has no such access (browsers) it is absent and blocks read the whole text. Throws with a
+   * message saying what is wrong (not found, no permission, outside the allowed folders).
+   */
+  openRead?(path: string): FileReadHandle;
+}
+
+/** A file opened by `Resources.openRead`. */
+export interface FileReadHandle {
+  /** The full path, for messages. */
+  readonly path: string;
+  /** Its size in bytes when opened; NaN when it is not a regular file (a device, a pipe: not opened). */
+  readonly size: number;
+  /** Reads up to `into.length` bytes at byte `position` into `into`; returns how many (0: the end). */
+  read(into: Uint8Array, position: number): number;
+  close(): void;
 }
 
 export interface TimerHandle {

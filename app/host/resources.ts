@@ -2,6 +2,7 @@ import { realpathSync } from "node:fs";
 import { mkdir, readFile, rename, rm, writeFile } from "node:fs/promises";
 import { basename, dirname, isAbsolute, relative, resolve, sep } from "node:path";
 import type { Resources } from "../engine/block";
+import { openFileRead } from "./file-read";
 
 /**
  * Writes by file. Writes to one file never overlap (two overlapping `writeFile`s to the same
@@ -139,6 +140,7 @@ export function nodeResources(baseDir: string, allowed?: AllowedFolders): Resour
         throw new Error(`cannot read ${full}: ${(e as Error).message}`);
       }
     },
+    openRead: (p: string) => openFileRead(confine(p, "read")),
     writeText: async (p: string, text: string) => {
       const full = confine(p, "write");
       try {

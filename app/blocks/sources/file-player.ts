@@ -5,13 +5,24 @@ import {
   errorMessage,
   LegacyParamsError,
   vectorShape,
+  type BlockContext,
+  type BlockInstance,
+  type FileReadHandle,
+  type Resources,
 } from "../../engine";
 import { timerInput } from "../shared/inputs";
+import { MAX_CHANNELS } from "../shared/limits";
 import { index } from "../shared/params";
 import { TextThrottle } from "../shared/text";
 import { MAX_TIMER_HZ } from "../timing/scheduled-timer";
-import { parseDelimited, TIME_COLUMN_NAMES } from "./delimited-text";
-import { MAX_CHANNELS } from "../shared/limits";
+import {
+  DelimitedStream,
+  FILE_LIMITS,
+  lastRowTime,
+  parseDelimited,
+  TIME_COLUMN_NAMES,
+  type ParseOptions,
+} from "./delimited-text";
 
 const columnRef = () => z.union([z.string().min(1), index()]);
 /** Most rows one wake-up of a self-timed player waits for (a batching interval rarely holds more). */
@@ -23,8 +34,13 @@ export const FilePlayer = defineBlock({
   summary: "Plays a CSV/text recording: one row per timer tick, or at the recording's own timing.",
   help:
     "Reads and plays back a recording (paper Table 3), e.g. a CSV with a `time_s` column or a " +
-    "log written by `Path`/Logger (then set `TimeColumn: 0`). The whole file is read and checked " +
-    "when the pipeline loads; a line that cannot be read is reported with its number and field. " +
+    "log written by `Path`/Logger (then set `TimeColumn: 0`). A file up to 32 MiB is read and " +
+    "checked whole when the pipeline loads; a bigger one is read in pieces as it plays (memory " +
+    "stays small whatever its size), after its layout, first 1000 rows and last line were " +
+    "checked at load, and a line that cannot be read later stops it with an error naming the " +
+    "line (a browser reads recordings whole, up to 32 MiB). A line that cannot be read is " +
+    "reported with its number and field; lines are at most 1 MiB, columns at most 65 536, and " +
+    "what is not a regular file (a device, a pipe) is refused. " +
     "With a timer input it emits one row per tick, stamped with the tick's time (the pace and " +
     "desired rate are the timer's). Without an input it plays the rows at their original timing: " +
     "row i at start + (t_i − t_0)/Speed, stamped with that time; the rows due within one " +
@@ -98,161 +114,358 @@ export const FilePlayer = defineBlock({
   async create(ctx, p) {
     const timed = ctx.inputs.length === 1;
     if (timed) timerInput(ctx, 0);
-    let text: string;
+    const src = await loadRows(ctx.resources, p, !timed);
     try {
-      text = await ctx.resources.readText(p.File);
+      return play(ctx, p, timed, src);
     } catch (e) {
-      let where = p.File;
-      try {
-        where = ctx.resources.resolve(p.File);
-      } catch {
-        // keep the name as written
-      }
-      throw new BlockConfigError(`cannot read '${where}': ${errorMessage(e)}`, "File");
+      src.close();
+      throw e;
     }
-    const table = parseDelimited(text, {
-      file: p.File,
-      header: p.Header,
-      delimiter: p.Delimiter,
-      columns: p.Columns,
-      timeColumn: p.TimeColumn,
-    });
-    const rows = table.rows;
-    const c = table.columns.length;
-    const values = table.values;
-    const times = table.times;
-    let span = 0;
-    if (!timed) {
-      if (!times) {
+  },
+});
+
+interface Params {
+  File: string;
+  Columns?: (string | number)[] | undefined;
+  TimeColumn?: string | number | false | undefined;
+  Header: "auto" | boolean;
+  Delimiter: "auto" | "," | ";" | "\t" | " ";
+  Loop: boolean;
+  Speed: number;
+}
+
+/**
+ * The rows of a recording as the player reads them: all in memory (a file up to
+ * FILE_LIMITS.wholeBytes, checked whole at load), or streamed from the file as they play. Row
+ * indices count from the first data row of the current pass.
+ */
+interface RowSource {
+  /** Every row is in memory: a scan may look past the end into the next pass (Loop). */
+  readonly whole: boolean;
+  /** Values per row. */
+  readonly width: number;
+  readonly hasTimes: boolean;
+  /** Rows in a pass, once known (from the start for a whole file). */
+  readonly total: number | undefined;
+  /** Makes rows [0, upTo) readable where they exist; returns min(upTo, rows available). */
+  fill(upTo: number): number;
+  time(r: number): number;
+  line(r: number): number;
+  copy(r: number, into: Float64Array, at: number): void;
+  /** Rows before `r` are not needed any more. */
+  release(r: number): void;
+  /** The next pass, from the first row. */
+  rewind(): void;
+  /** The time of the file's last row. */
+  lastTime(): number;
+  /** Why the rows end before the file does (a bad line met while playing). */
+  readonly error: string | undefined;
+  close(): void;
+}
+
+const disorderText = (line: number, file: string, t: number, prev: number): string =>
+  `line ${line} of '${file}': time ${t} is before the previous row's ${prev}; original ` +
+  "timing needs non-decreasing times";
+
+function wholeRows(text: string, o: ParseOptions): RowSource {
+  const t = parseDelimited(text, o);
+  const c = t.columns.length;
+  return {
+    whole: true,
+    width: c,
+    hasTimes: t.times !== null,
+    total: t.rows,
+    fill: (upTo) => Math.min(upTo, t.rows),
+    time: (r) => t.times![r]!,
+    line: (r) => t.lines[r]!,
+    copy(r, into, at) {
+      for (let k = 0; k < c; k++) into[at + k] = t.values[r * c + k]!;
+    },
+    release() {},
+    rewind() {},
+    lastTime: () => t.times![t.rows - 1]!,
+    error: undefined,
+    close() {},
+  };
+}
+
+/**
+ * A big file's rows, read as they play. With `ordered` (original timing), a row whose time is
+ * before the previous one ends the rows there.
+ */
+function streamedRows(h: FileReadHandle, o: ParseOptions, ordered: boolean): RowSource {
+  const s = new DelimitedStream(h, o);
+  let checked = 0;
+  let prev = -Infinity;
+  let disorder: string | undefined;
+  let total: number | undefined;
+  return {
+    whole: false,
+    width: s.layout.columns.length,
+    hasTimes: s.layout.timeColumn >= 0,
+    get total() {
+      return total;
+    },
+    fill(upTo) {
+      let n = s.fill(upTo);
+      if (ordered) {
+        for (; checked < n && disorder === undefined; checked++) {
+          const t = s.time(checked);
+          if (!(t >= prev)) {
+            disorder = disorderText(s.line(checked), o.file, t, prev);
+            break;
+          }
+          prev = t;
+        }
+        if (disorder !== undefined) n = Math.min(n, checked);
+      }
+      if (s.ended && s.error === undefined && disorder === undefined) total = s.known;
+      return n;
+    },
+    time: (r) => s.time(r),
+    line: (r) => s.line(r),
+    copy: (r, into, at) => s.copy(r, into, at),
+    release: (r) => s.release(r),
+    rewind() {
+      s.rewind();
+      checked = 0;
+      prev = -Infinity;
+    },
+    lastTime: () => lastRowTime(h, h.size, s.layout, o),
+    get error() {
+      return disorder ?? s.error?.message;
+    },
+    close: () => h.close(),
+  };
+}
+
+/** Reads a whole (small) file through its handle. */
+function readWhole(h: FileReadHandle): string {
+  const buf = new Uint8Array(h.size);
+  let got = 0;
+  while (got < buf.length) {
+    const n = h.read(buf.subarray(got), got);
+    if (n === 0) break;
+    got += n;
+  }
+  const decoder = new (
+    globalThis as unknown as {
+      TextDecoder: new () => { decode(b: Uint8Array): string };
+    }
+  ).TextDecoder();
+  return decoder.decode(buf.subarray(0, got));
+}
+
+/**
+ * Opens the recording: streamed when the host reads in pieces (Node) and the file is bigger than
+ * FILE_LIMITS.wholeBytes, else read whole (and a text bigger than that refused).
+ */
+async function loadRows(res: Resources, p: Params, ordered: boolean): Promise<RowSource> {
+  const where = (): string => {
+    try {
+      return res.resolve(p.File);
+    } catch {
+      return p.File;
+    }
+  };
+  const o: ParseOptions = {
+    file: p.File,
+    header: p.Header,
+    delimiter: p.Delimiter,
+    columns: p.Columns,
+    timeColumn: p.TimeColumn,
+  };
+  let h: FileReadHandle | undefined;
+  try {
+    h = res.openRead?.(p.File);
+  } catch (e) {
+    throw new BlockConfigError(`cannot read '${where()}': ${errorMessage(e)}`, "File");
+  }
+  if (h && Number.isNaN(h.size)) {
+    throw new BlockConfigError(
+      `'${h.path}' is not a regular file (a device or a pipe): a FilePlayer plays recordings ` +
+        "saved as files",
+      "File",
+    );
+  }
+  if (h && h.size > FILE_LIMITS.wholeBytes) {
+    try {
+      return streamedRows(h, o, ordered);
+    } catch (e) {
+      h.close();
+      throw e;
+    }
+  }
+  let text: string;
+  try {
+    text = h ? readWhole(h) : await res.readText(p.File);
+  } catch (e) {
+    throw new BlockConfigError(`cannot read '${where()}': ${errorMessage(e)}`, "File");
+  } finally {
+    h?.close();
+  }
+  if (text.length > FILE_LIMITS.wholeBytes) {
+    throw new BlockConfigError(
+      `'${p.File}' has ${text.length} characters; here a recording is read whole, at most ` +
+        `${FILE_LIMITS.wholeBytes} (mosaic run and the desktop app play bigger files as they read ` +
+        "them)",
+      "File",
+    );
+  }
+  return wholeRows(text, o);
+}
+
+/** The load-time checks of original timing and the player itself. */
+function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): BlockInstance {
+  const c = src.width;
+  // The first rows must be readable when the pipeline loads (all of a whole file).
+  const first = src.fill(src.total ?? FILE_LIMITS.firstRows);
+  if (src.error !== undefined && first < FILE_LIMITS.firstRows) {
+    throw new BlockConfigError(src.error, "File");
+  }
+  if (first === 0) throw new BlockConfigError(`'${p.File}' has a header but no data rows`, "File");
+  let span = 0;
+  let t0 = 0;
+  if (!timed) {
+    if (!src.hasTimes) {
+      throw new BlockConfigError(
+        `'${p.File}' has no time column, so it cannot be played at its original timing; either ` +
+          "give the FilePlayer a timer input (one row per tick) or name the time column with " +
+          "TimeColumn",
+        "TimeColumn",
+      );
+    }
+    if (first < 2) {
+      throw new BlockConfigError(
+        `'${p.File}' has only one row; original timing needs at least two rows (or a timer input)`,
+        "File",
+      );
+    }
+    // The rows checked at load (all of a whole file) give the median interval.
+    const dts = new Float64Array(first - 1);
+    for (let i = 1; i < first; i++) {
+      const dt = src.time(i) - src.time(i - 1);
+      if (!(dt >= 0)) {
         throw new BlockConfigError(
-          `'${p.File}' has no time column, so it cannot be played at its original timing; either ` +
-            "give the FilePlayer a timer input (one row per tick) or name the time column with " +
-            "TimeColumn",
+          disorderText(src.line(i), p.File, src.time(i), src.time(i - 1)),
           "TimeColumn",
         );
       }
-      if (rows < 2) {
-        throw new BlockConfigError(
-          `'${p.File}' has only one row; original timing needs at least two rows (or a timer input)`,
-          "File",
-        );
-      }
-      const dts = new Float64Array(rows - 1);
-      for (let i = 1; i < rows; i++) {
-        const dt = times[i]! - times[i - 1]!;
-        if (!(dt >= 0)) {
-          throw new BlockConfigError(
-            `line ${table.lines[i]} of '${p.File}': time ${times[i]} is before the previous row's ` +
-              `${times[i - 1]}; original timing needs non-decreasing times`,
-            "TimeColumn",
-          );
-        }
-        dts[i - 1] = dt;
-      }
-      dts.sort();
-      const m = dts.length;
-      const median = m % 2 === 1 ? dts[(m - 1) / 2]! : (dts[m / 2 - 1]! + dts[m / 2]!) / 2;
-      if (!(median > 0)) {
-        throw new BlockConfigError(
-          `the median interval between rows of '${p.File}' is 0 (repeated times); original ` +
-            "timing needs increasing times",
-          "TimeColumn",
-        );
-      }
-      const rowHz = p.Speed / median;
-      if (rowHz > MAX_TIMER_HZ) {
-        const fileHz = Number((1 / median).toPrecision(6));
-        throw new BlockConfigError(
-          p.Speed !== 1
-            ? `at Speed ${p.Speed} the rows of '${p.File}' (${fileHz} Hz) would play at ` +
-                `${Number(rowHz.toPrecision(6))} Hz, above the fastest the engine paces, ` +
-                `${MAX_TIMER_HZ} Hz: lower Speed`
-            : `the rows of '${p.File}' come at ${fileHz} Hz, above the fastest the engine paces, ` +
-                `${MAX_TIMER_HZ} Hz: play it with a timer input (one row per tick) or resample it`,
-          p.Speed !== 1 ? "Speed" : "File",
-        );
-      }
-      span = times[rows - 1]! - times[0]! + median;
-      if (ctx.declaredRate === undefined) ctx.setDesiredRate(p.Speed / median);
+      dts[i - 1] = dt;
     }
-    const t0 = times ? times[0]! : 0;
-    const speed = p.Speed;
-    const loop = p.Loop;
-    const out = ctx.output(vectorShape(c));
+    dts.sort();
+    const m = dts.length;
+    const median = m % 2 === 1 ? dts[(m - 1) / 2]! : (dts[m / 2 - 1]! + dts[m / 2]!) / 2;
+    if (!(median > 0)) {
+      throw new BlockConfigError(
+        `the median interval between rows of '${p.File}' is 0 (repeated times); original ` +
+          "timing needs increasing times",
+        "TimeColumn",
+      );
+    }
+    const rowHz = p.Speed / median;
+    if (rowHz > MAX_TIMER_HZ) {
+      const fileHz = Number((1 / median).toPrecision(6));
+      throw new BlockConfigError(
+        p.Speed !== 1
+          ? `at Speed ${p.Speed} the rows of '${p.File}' (${fileHz} Hz) would play at ` +
+              `${Number(rowHz.toPrecision(6))} Hz, above the fastest the engine paces, ` +
+              `${MAX_TIMER_HZ} Hz: lower Speed`
+          : `the rows of '${p.File}' come at ${fileHz} Hz, above the fastest the engine paces, ` +
+              `${MAX_TIMER_HZ} Hz: play it with a timer input (one row per tick) or resample it`,
+        p.Speed !== 1 ? "Speed" : "File",
+      );
+    }
+    t0 = src.time(0);
+    // Only a loop needs the last row (read from the file's end when it streams).
+    if (p.Loop) span = src.lastTime() - t0 + median;
+    if (ctx.declaredRate === undefined) ctx.setDesiredRate(rowHz);
+  }
+  const speed = p.Speed;
+  const loop = p.Loop;
+  const out = ctx.output(vectorShape(c));
 
-    let row = 0;
-    let loops = 0;
-    let done = false;
-    let paused = false;
-    let started = false;
-    let base = NaN;
-    let pausedAt = NaN;
-    let stoppedAt = NaN;
-    const throttle = new TextThrottle();
+  let row = 0;
+  let loops = 0;
+  let done = false;
+  let paused = false;
+  let started = false;
+  let base = NaN;
+  let pausedAt = NaN;
+  let stoppedAt = NaN;
+  /** Why playing stopped early: a bad line met in a streamed file. */
+  let failed: string | undefined;
+  const throttle = new TextThrottle();
+  const has = (r: number): boolean => src.fill(r + 1) > r;
 
-    const describe = () => {
-      if (done) ctx.setText(`finished: ${rows} rows played`);
-      else
-        ctx.setText(
-          `${paused ? "paused at " : ""}row ${row} / ${rows}${loops > 0 ? ` (loop ${loops + 1})` : ""}`,
-        );
-    };
-    const finish = () => {
-      done = true;
-      describe();
-      ctx.finish();
-    };
-    /** Advances past the row just played; returns false when playback ended. */
-    const advance = (): boolean => {
-      row++;
-      if (row < rows) return true;
-      if (loop) {
-        row = 0;
-        loops++;
-        return true;
-      }
-      return false;
-    };
-    const dueTime = (r: number, l: number): number => base + (times![r]! - t0 + l * span) / speed;
-    /**
-     * When to wake next: the due time of the last row within the batching interval of the next
-     * one (rows then go out together, as a device sends packets; DESIGN.md §3).
-     */
-    const nextWake = (): number => {
-      const first = dueTime(row, loops);
-      const batch = ctx.batching;
-      if (!(batch > 0)) return first;
-      let last = first;
-      let r = row;
-      let l = loops;
-      for (let k = 0; k < MAX_BATCH_ROWS; k++) {
-        r++;
-        if (r >= rows) {
-          if (!loop) break;
-          r = 0;
-          l++;
-        }
-        const d = dueTime(r, l);
-        if (d > first + batch) break;
-        last = d;
-      }
-      return last;
-    };
+  const describe = () => {
+    const total = src.total !== undefined ? ` / ${src.total}` : "";
+    if (failed !== undefined) ctx.setText(`stopped at row ${row}: ${failed}`);
+    else if (done) ctx.setText(`finished: ${src.total ?? row} rows played`);
+    else
+      ctx.setText(
+        `${paused ? "paused at " : ""}row ${row}${total}${loops > 0 ? ` (loop ${loops + 1})` : ""}`,
+      );
+  };
+  const finish = () => {
+    done = true;
+    if (src.error !== undefined && failed === undefined) {
+      failed = src.error;
+      ctx.error(`stopped playing: ${failed}`);
+    }
+    describe();
+    ctx.finish();
+  };
+  /** Advances past the row just played; returns false when playback ended. */
+  const advance = (): boolean => {
+    row++;
+    if (has(row)) return true;
+    if (src.error !== undefined) return false;
+    if (loop) {
+      src.rewind();
+      row = 0;
+      loops++;
+      return has(0);
+    }
+    return false;
+  };
+  const dueTime = (r: number, l: number): number => base + (src.time(r) - t0 + l * span) / speed;
+  /** The row after `r` of pass `l` in a scan ahead, or undefined where the scan stops. */
+  const after = (r: number, l: number): [number, number] | undefined => {
+    if (has(r + 1)) return [r + 1, l];
+    // A streamed file's next pass is read after this one: scans stop at its end.
+    if (!loop || !src.whole) return undefined;
+    return [0, l + 1];
+  };
+  /**
+   * When to wake next: the due time of the last row within the batching interval of the next
+   * one (rows then go out together, as a device sends packets; DESIGN.md §3).
+   */
+  const nextWake = (): number => {
+    const first = dueTime(row, loops);
+    const batch = ctx.batching;
+    if (!(batch > 0)) return first;
+    let last = first;
+    let at: [number, number] | undefined = [row, loops];
+    for (let k = 0; k < MAX_BATCH_ROWS; k++) {
+      at = after(at[0], at[1]);
+      if (!at) break;
+      const d = dueTime(at[0], at[1]);
+      if (d > first + batch) break;
+      last = d;
+    }
+    return last;
+  };
 
-    const onTime = (t: number): void => {
-      if (paused || done) return;
+  const onTime = (t: number): void => {
+    if (paused || done) return;
+    for (;;) {
       // Count the rows due by now, then emit them in one frame stamped with their own times.
       let n = 0;
-      let r = row;
-      let l = loops;
-      while (dueTime(r, l) <= t) {
+      let at: [number, number] | undefined = [row, loops];
+      while (at && dueTime(at[0], at[1]) <= t) {
         n++;
-        r++;
-        if (r >= rows) {
-          if (!loop) break;
-          r = 0;
-          l++;
-        }
+        at = after(at[0], at[1]);
       }
       let ended = false;
       if (n > 0) {
@@ -260,109 +473,127 @@ export const FilePlayer = defineBlock({
         const ov = o.v;
         for (let e = 0; e < n; e++) {
           o.t[e] = dueTime(row, loops);
-          const src = row * c;
-          const dst = e * c;
-          for (let k = 0; k < c; k++) ov[dst + k] = values[src + k]!;
-          if (!advance()) ended = true;
+          src.copy(row, ov, e * c);
+          if (!advance()) {
+            ended = true;
+            o.n = e + 1;
+            break;
+          }
         }
+        src.release(row);
         out.emit(o);
       }
       if (ended) {
         finish();
         return;
       }
-      if (throttle.due(t)) describe();
-      ctx.at(nextWake(), onTime);
-    };
+      // A streamed file's next pass (Loop) begins after this frame: its due rows go in the next.
+      if (n > 0 && !src.whole && row === 0 && dueTime(0, loops) <= t) continue;
+      break;
+    }
+    if (throttle.due(t)) describe();
+    ctx.at(nextWake(), onTime);
+  };
 
-    const schedule = () => {
-      if (timed || paused || done || !started) return;
-      ctx.at(nextWake(), onTime);
-    };
-    const rewind = () => {
-      row = 0;
-      loops = 0;
-      done = false;
-      throttle.reset();
-      if (!timed && started) base = ctx.now();
-      describe();
-      schedule();
-    };
+  const schedule = () => {
+    if (timed || paused || done || !started) return;
+    ctx.at(nextWake(), onTime);
+  };
+  const rewind = () => {
+    if (row !== 0 || loops !== 0 || done) src.rewind();
+    row = 0;
+    loops = 0;
+    done = false;
+    failed = undefined;
+    throttle.reset();
+    if (!timed && started) base = ctx.now();
     describe();
+    schedule();
+  };
+  describe();
 
-    return {
-      start() {
-        started = true;
-        if (!timed) {
-          // The first start plays from the pipeline start; after a stop, the remaining rows
-          // move by the time it was stopped (as after pause/resume), so none bursts out late.
-          if (Number.isNaN(base)) base = ctx.startTime;
-          else if (!paused && !Number.isNaN(stoppedAt)) base += ctx.now() - stoppedAt;
+  return {
+    start() {
+      started = true;
+      if (!timed) {
+        // The first start plays from the pipeline start; after a stop, the remaining rows
+        // move by the time it was stopped (as after pause/resume), so none bursts out late.
+        if (Number.isNaN(base)) base = ctx.startTime;
+        else if (!paused && !Number.isNaN(stoppedAt)) base += ctx.now() - stoppedAt;
+      }
+      schedule();
+    },
+    stop() {
+      started = false;
+      stoppedAt = ctx.now();
+    },
+    process(f) {
+      if (paused || done) return;
+      const want = f.n;
+      if (want === 0) return;
+      const n = loop ? want : Math.min(want, src.fill(row + want) - row);
+      if (n <= 0) {
+        finish();
+        return;
+      }
+      const o = out.frame(n);
+      const ov = o.v;
+      const ft = f.t;
+      let ended = false;
+      for (let e = 0; e < n; e++) {
+        o.t[e] = ft[e]!;
+        src.copy(row, ov, e * c);
+        if (!advance()) {
+          ended = true;
+          o.n = e + 1;
+          break;
         }
-        schedule();
-      },
-      stop() {
-        started = false;
-        stoppedAt = ctx.now();
-      },
-      process(f) {
-        if (paused || done) return;
-        const want = f.n;
-        if (want === 0) return;
-        const n = loop ? want : Math.min(want, rows - row);
-        const o = out.frame(n);
-        const ov = o.v;
-        const ft = f.t;
-        let ended = false;
-        for (let e = 0; e < n; e++) {
-          o.t[e] = ft[e]!;
-          const src = row * c;
-          const dst = e * c;
-          for (let k = 0; k < c; k++) ov[dst + k] = values[src + k]!;
-          if (!advance()) ended = true;
-        }
-        out.emit(o);
-        if (ended) finish();
-        else if (throttle.due(ft[n - 1]!)) describe();
-      },
-      reset() {
-        paused = false;
-        rewind();
-      },
-      actions: {
-        restart: {
-          label: "Restart",
-          description: "Play again from the first row",
-          run() {
-            paused = false;
-            rewind();
-            return `restarted ${p.File}`;
-          },
-        },
-        pause: {
-          label: "Pause",
-          description: "Stop emitting rows until resumed",
-          run() {
-            if (paused || done) return done ? "already finished" : "already paused";
-            paused = true;
-            pausedAt = ctx.now();
-            describe();
-            return `paused at row ${row}`;
-          },
-        },
-        resume: {
-          label: "Resume",
-          description: "Continue from the row where it paused",
-          run() {
-            if (!paused) return "not paused";
-            paused = false;
-            if (!timed && !Number.isNaN(base)) base += ctx.now() - pausedAt;
-            describe();
-            schedule();
-            return `resumed at row ${row}`;
-          },
+      }
+      src.release(row);
+      out.emit(o);
+      if (ended) finish();
+      else if (throttle.due(ft[o.n - 1]!)) describe();
+    },
+    reset() {
+      paused = false;
+      rewind();
+    },
+    dispose() {
+      src.close();
+    },
+    actions: {
+      restart: {
+        label: "Restart",
+        description: "Play again from the first row",
+        run() {
+          paused = false;
+          rewind();
+          return `restarted ${p.File}`;
         },
       },
-    };
-  },
-});
+      pause: {
+        label: "Pause",
+        description: "Stop emitting rows until resumed",
+        run() {
+          if (paused || done) return done ? "already finished" : "already paused";
+          paused = true;
+          pausedAt = ctx.now();
+          describe();
+          return `paused at row ${row}`;
+        },
+      },
+      resume: {
+        label: "Resume",
+        description: "Continue from the row where it paused",
+        run() {
+          if (!paused) return "not paused";
+          paused = false;
+          if (!timed && !Number.isNaN(base)) base += ctx.now() - pausedAt;
+          describe();
+          schedule();
+          return `resumed at row ${row}`;
+        },
+      },
+    },
+  };
+}
