@@ -26,6 +26,11 @@ and writes DIR/latest.json and DIR/latest.md (default DIR: bench/results).
   --out DIR     where to write latest.json and latest.md
   --quick       a smoke test: 1 s warm-up, 3 s steady state, short replays (about 40 s in all)
 
+soak (only with --only soak, not in the suite) runs the Delsys pipeline with the Python sidecar
+and a UDP sender for 30 minutes after the warm-up (--duration S instead; --quick: 3 s) and
+checks that VmRSS stays within 5 %, that every datagram sent arrived or was counted as not sent,
+and that every error was counted.
+
 Exit 0 when every selected workload ran (missed targets are reported, not an error), 1 when one
 failed to run, 2 on bad options.
 `;
@@ -47,6 +52,8 @@ export interface BenchOptions {
   only: string | undefined;
   /** `--out` as given. */
   out: string | undefined;
+  /** `--duration` was given (the soak's own length applies otherwise). */
+  durationGiven: boolean;
   selected: WorkloadDef[];
 }
 
@@ -73,9 +80,20 @@ export function parseBenchOptions(argv: string[]): BenchOptions | { exit: number
     process.stderr.write(`mosaic bench: ${(e as Error).message}\n`);
     return { exit: 2 };
   }
-  const selected = values.only !== undefined ? selectWorkloads(values.only) : WORKLOADS;
+  const selected =
+    values.only !== undefined
+      ? selectWorkloads(values.only)
+      : WORKLOADS.filter((w) => !("explicit" in w && w.explicit));
   if (!selected) return { exit: 2 };
-  return { quick, steady, warmup, only: values.only, out: values.out, selected };
+  return {
+    quick,
+    steady,
+    warmup,
+    only: values.only,
+    out: values.out,
+    durationGiven: values.duration !== undefined,
+    selected,
+  };
 }
 
 function parseFlags(argv: string[]) {

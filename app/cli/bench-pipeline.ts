@@ -26,9 +26,11 @@ export interface PipelineRunOptions {
   batchingMs?: number;
 }
 
+/** `inspect` sees the child run before its figures are taken (the soak's own accounting). */
 export async function runPipeline(
   def: PipelineDef,
   o: PipelineRunOptions,
+  inspect?: (run: ChildRun) => void,
 ): Promise<PipelineResult> {
   const path = join(o.root, "pipelines", "bench", def.file);
   const file = relative(o.root, path);
@@ -48,6 +50,7 @@ export async function runPipeline(
     return res;
   }
   const run = await runBeside(def, o, args, total, rx, res);
+  inspect?.(run);
   recordRun(res, run);
   if (!run.summary) return res;
   recordSummary(res, run, run.summary, o.useNs);

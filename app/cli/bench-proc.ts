@@ -44,6 +44,8 @@ export interface CpuSample {
   /** CPU % of one core of the child's own child processes (e.g. Python sidecars), from their
    * /proc/<pid>/stat; 0 when it has none. */
   childrenPct: number;
+  /** VmRSS of those child processes together, KiB (0 without). */
+  childrenRssKiB: number;
   /** After the warm-up (steady state)? */
   steady: boolean;
 }
@@ -96,6 +98,8 @@ export interface ChildRun {
   /** Warning and error events printed by the child (first few kept). */
   events: { level: string; block: string; message: string }[];
   eventCount: number;
+  /** Events printed by the child, by level (error, warning, info). */
+  eventsByLevel: Record<string, number>;
   stderrTail: string;
 }
 
@@ -174,6 +178,7 @@ class ChildMonitor {
       killedAfterSummary: false,
       events: [],
       eventCount: 0,
+      eventsByLevel: {},
       stderrTail: "",
     };
   }
@@ -255,6 +260,10 @@ class ChildMonitor {
       nsPct: (nsDelta(last.ns, cur.ns) / 1e9 / dt) * 100,
       rssKiB: readStatusKiB(pid, "VmRSS"),
       childrenPct: (childrenDelta(last.children, cur.children) / this.tck / dt) * 100,
+      childrenRssKiB: [...cur.children.keys()].reduce(
+        (a, c) => a + (readStatusKiB(c, "VmRSS") || 0),
+        0,
+      ),
       steady,
     });
     this.readPeakRss(pid);
@@ -339,6 +348,8 @@ class ChildMonitor {
 
   private onEvent(m: Record<string, unknown>): void {
     this.res.eventCount++;
+    const level = String(m.level);
+    this.res.eventsByLevel[level] = (this.res.eventsByLevel[level] ?? 0) + 1;
     if (this.res.events.length < 20) {
       this.res.events.push({
         level: String(m.level),

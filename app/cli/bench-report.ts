@@ -4,6 +4,7 @@
  */
 import { failed, fmt, fmtRateSI, load, section, table } from "./bench-format";
 import { pipelineMarkdown } from "./bench-report-pipeline";
+import { soakMarkdown } from "./bench-soak";
 import type {
   BatchingResult,
   BatchingRow,
@@ -29,6 +30,8 @@ export function workloadMarkdown(r: WorkloadResult): string[] {
       return udpMarkdown(r, "##");
     case "replay":
       return replayMarkdown([r], "##");
+    case "soak":
+      return soakMarkdown(r, "##");
   }
 }
 

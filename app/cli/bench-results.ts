@@ -15,6 +15,7 @@ import {
   udpMarkdown,
 } from "./bench-report";
 import { pipelineMarkdown } from "./bench-report-pipeline";
+import { soakMarkdown } from "./bench-soak";
 import type { ReplayResult, TargetRow, WorkloadResult } from "./bench-types";
 
 /** latest.json. */
@@ -113,6 +114,7 @@ export function latestMarkdown(doc: BenchDocument): string {
   for (const r of results) if (r.kind === "batching") lines.push(...batchingMarkdown(r, "##"));
   // (latest.md has always written a UDP failure's message as it is, even when there is none)
   for (const r of results) if (r.kind === "udp") lines.push(...udpMarkdown(r, "##", `${r.error}`));
+  for (const r of results) if (r.kind === "soak") lines.push(...soakMarkdown(r, "##"));
   return lines.join("\n") + "\n";
 }
 

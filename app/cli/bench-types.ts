@@ -240,8 +240,72 @@ export interface BatchingResult {
   killedAfterSummary: boolean;
 }
 
+/** The soak (bench-soak.ts): one long run and what it must not leak or lose. */
+export interface SoakResult {
+  kind: "soak";
+  id: string;
+  title: string;
+  ok: boolean;
+  error?: string;
+  /** Every check below passed (memory flat, nothing uncounted, errors consistent). */
+  pass: boolean;
+  /** Why it did not, one item per failed check. */
+  failures: string[];
+  warmupSeconds: number;
+  steadySeconds: number;
+  /** VmRSS of the Python sidecar(s) (the run's child processes) over the steady state, MiB. */
+  sidecarRss: { startMiB: number; endMiB: number; maxMiB: number; driftPct: number } | null;
+  /** VmRSS of the `mosaic run` process over the steady state (1-s samples), MiB. */
+  rss: {
+    samples: number;
+    startMiB: number;
+    endMiB: number;
+    maxMiB: number;
+    minMiB: number;
+    /** Samples in each of the first and the last window (a minute, a tenth of a shorter run). */
+    windowSamples: number;
+    firstMedianMiB: number;
+    lastMedianMiB: number;
+    /** (last − first) / first of those medians, and (max − first) / first, %. */
+    driftPct: number;
+    maxOverStartPct: number;
+    tolerancePct: number;
+    flat: boolean;
+  } | null;
+  /**
+   * The Sender's datagrams over the whole run: sent and not sent (counted, with the last reason)
+   * as its status says, received by the bench, and sent but never received (uncounted: must be 0).
+   */
+  udp: {
+    sent: number | null;
+    notSent: number | null;
+    notSentReason: string;
+    received: number;
+    malformed: number;
+    uncounted: number | null;
+  };
+  /** What the engine counted as lost: edge drops and missed ticks (all time). */
+  drops: { edges: number; missedTicks: number };
+  /**
+   * Errors: per block as its telemetry counts them (the summary), the error and warning events
+   * printed, and the run's exit code (1 exactly when a block counted an error).
+   */
+  errors: {
+    total: number;
+    blocks: { name: string; errors: number; lastError: string }[];
+    events: Record<string, number>;
+    exitCode: number | null;
+    consistent: boolean;
+  };
+  /** The pipeline run itself, as the pipeline workloads report it (CPU, Tables 5/6, UDP). */
+  run: PipelineResult;
+  loadAvgBefore: number[];
+  loadAvgAfter: number[];
+  killedAfterSummary: boolean;
+}
+
 export type WorkloadResult =
-  PipelineResult | ReplayResult | LearnResult | UdpResult | BatchingResult;
+  PipelineResult | ReplayResult | LearnResult | UdpResult | BatchingResult | SoakResult;
 
 export interface TargetRow {
   id: string;

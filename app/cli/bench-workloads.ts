@@ -48,7 +48,26 @@ export interface UdpDef {
   title: string;
   timerHz: number;
 }
-export type WorkloadDef = PipelineDef | ReplayDef | LearnDef | UdpDef | BatchingDef;
+/**
+ * The soak: a long real-time run of one pipeline (memory drift, every datagram and every error
+ * accounted for). Not part of the default suite: `--only soak`.
+ */
+export interface SoakDef {
+  kind: "soak";
+  id: string;
+  title: string;
+  /** In pipelines/bench/; its Sender's port is where the bench's receiver listens. */
+  file: string;
+  acquisition: string;
+  udpRateHz: number;
+  /** Steady-state seconds unless `--duration` says otherwise (`--quick`: its own 3 s). */
+  steadySeconds: number;
+  /** VmRSS may move this much (%) between the start and the end of the steady state. */
+  memoryTolerancePct: number;
+  /** Run only when `--only` names it. */
+  explicit: true;
+}
+export type WorkloadDef = PipelineDef | ReplayDef | LearnDef | UdpDef | BatchingDef | SoakDef;
 
 /** 1926 Hz / 77: the Delsys pipelines' 25 Hz branch (MOSAIC's 25.013 Hz). */
 const DELSYS_25 = 1926 / 77;
@@ -163,6 +182,18 @@ export const WORKLOADS: WorkloadDef[] = [
       "Batching sweep — the Delsys and Myo pipelines at --batching-ms 0, 1, 2, 5, 10: CPU, engine wake-ups, delivery delay",
     pipelines: ["delsys", "myo"],
     intervalsMs: [0, 1, 2, 5, 10],
+  },
+  {
+    kind: "soak",
+    id: "soak",
+    title:
+      "Soak — the Delsys pipeline with the Python sidecar (ONNX CNN) and a UDP sender for 30 minutes: memory drift, datagrams and errors accounted for",
+    file: "python-cnn.yaml",
+    acquisition: "Delsys",
+    udpRateHz: DELSYS_25,
+    steadySeconds: 1800,
+    memoryTolerancePct: 5,
+    explicit: true,
   },
 ];
 

@@ -17,6 +17,7 @@ import { parseBenchOptions, type BenchOptions } from "./bench-options";
 import { addWakeFloor, runPipeline } from "./bench-pipeline";
 import { schedstatAvailable } from "./bench-procfs";
 import { runReplay } from "./bench-replay";
+import { runSoak } from "./bench-soak";
 import { targetsTable, workloadMarkdown } from "./bench-report";
 import { resultsDocument, writeResults } from "./bench-results";
 import { targets } from "./bench-targets";
@@ -138,5 +139,14 @@ async function runWorkload(def: WorkloadDef, s: Suite): Promise<WorkloadResult> 
       return runUdp(def, { quick, root });
     case "replay":
       return runReplay(def, { cli, root, tmp: s.tmp(), quick, targetWall: quick ? 1 : 6 });
+    case "soak":
+      // Its own length (30 min) unless --duration or --quick says otherwise.
+      return runSoak(def, {
+        cli,
+        root,
+        warmup,
+        steady: s.opts.durationGiven || quick ? steady : def.steadySeconds,
+        useNs,
+      });
   }
 }
