@@ -128,6 +128,26 @@ describe("loading is near-linear", () => {
       `600 blocks ${small.toFixed(2)} s, 2400 blocks ${large.toFixed(2)} s`,
     ).toBeLessThan(6);
   }, 120_000);
+
+  test("blocks sharing one Path: one error each, 4× the blocks in less than 6× the time", () => {
+    const samePath = (n: number) =>
+      Array.from(
+        { length: n },
+        (_, i) => `T${i}: { Type: ScheduledTimer, DesiredRate: 10, Path: same.txt }`,
+      ).join("\n") + "\n";
+    // Each error looked its block up by a scan of the document's entries.
+    const time = (n: number) => timed(() => errorsOf(samePath(n)));
+    time(200);
+    const [e, small] = time(2000);
+    expect(e).toHaveLength(1999);
+    expect(e[0]!.message).toContain("is also written by block 'T0' (Path at 1:");
+    let large = Infinity;
+    for (let i = 0; i < 2; i++) large = Math.min(large, time(8000)[1]);
+    expect(
+      large / small,
+      `2000 blocks ${small.toFixed(2)} s, 8000 blocks ${large.toFixed(2)} s`,
+    ).toBeLessThan(6);
+  }, 120_000);
 });
 
 describe("limits: refused fast, positioned, naming the limit", () => {

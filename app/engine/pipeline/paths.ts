@@ -35,13 +35,27 @@ export function logFilesOf(b: BlockSpec): { port: string; file: string }[] {
   }));
 }
 
+/** The blocks' entries of the document by name, indexed once per document (an error per block of a big file stays linear). */
+const entriesByDoc = new WeakMap<Document, Map<unknown, YamlNode>>();
+
+function blockEntry(doc: Document, name: string): YamlNode | undefined {
+  let index = entriesByDoc.get(doc);
+  if (!index) {
+    index = new Map();
+    const root = doc.contents;
+    if (isMap(root))
+      for (const p of root.items)
+        if (isScalar(p.key) && !index.has(p.key.value)) index.set(p.key.value, p.value as YamlNode);
+    entriesByDoc.set(doc, index);
+  }
+  return index.get(name);
+}
+
 /** The position of a block's `Path` value (the block's own position when it cannot be found). */
 function pathPos(c: Collector, doc: Document | undefined, b: BlockSpec): SourcePos {
-  const root = doc?.contents;
-  if (!isMap(root)) return b.pos;
-  const entry = root.items.find((p) => isScalar(p.key) && p.key.value === b.name);
-  if (!entry || !isMap(entry.value)) return b.pos;
-  const path = entry.value.items.find((p) => isScalar(p.key) && p.key.value === "Path");
+  const entry = doc ? blockEntry(doc, b.name) : undefined;
+  if (!entry || !isMap(entry)) return b.pos;
+  const path = entry.items.find((p) => isScalar(p.key) && p.key.value === "Path");
   return path ? c.pos((path.value ?? path.key) as YamlNode) : b.pos;
 }
 
