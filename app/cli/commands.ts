@@ -530,8 +530,27 @@ async function cmdServe(args: string[]): Promise<number> {
   return 0;
 }
 
+/** A command's arguments that parseArgs refused (unknown option, missing value): its message, exit 2. */
+function isArgsError(e: unknown): e is Error {
+  return e instanceof Error && String((e as { code?: unknown }).code).startsWith("ERR_PARSE_ARGS");
+}
+
 export async function main(argv: string[]): Promise<number> {
   const [cmd, ...rest] = argv;
+  if (cmd !== undefined && (rest.includes("--help") || rest.includes("-h"))) {
+    out(HELP);
+    return 0;
+  }
+  try {
+    return await dispatch(cmd, rest);
+  } catch (e) {
+    if (!isArgsError(e)) throw e;
+    err(`mosaic ${cmd}: ${e.message.split(". To specify a positional")[0]} (see mosaic --help)`);
+    return 2;
+  }
+}
+
+async function dispatch(cmd: string | undefined, rest: string[]): Promise<number> {
   switch (cmd) {
     case undefined:
     case "-h":

@@ -133,3 +133,17 @@ describe("mosaic run", () => {
     );
   });
 });
+
+describe("command-line arguments", () => {
+  test("a command's --help prints the usage, exit 0", () => {
+    const r = runCli(["run", "--help"]);
+    expect(r.code).toBe(0);
+    expect(r.stdout).toContain("mosaic format FILE... [--check]");
+  });
+
+  test("an unknown option is one line naming it, exit 2, no stack trace", () => {
+    const r = runCli(["run", "x.yaml", "--durration", "1"]);
+    expect(r.code).toBe(2);
+    expect(r.stderr.trim()).toBe("mosaic run: Unknown option '--durration' (see mosaic --help)");
+  });
+});

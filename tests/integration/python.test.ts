@@ -199,7 +199,8 @@ Other: { Type: Function, Inputs: [Emg], Params: { Operation: abs } }
     expect(events.some((e) => /restarted \(pid \d+\)/.test(String(e.message)))).toBe(true);
     expect(last.text).toMatch(/1 restart\b/);
     expect(pidOf()).not.toBe(first);
-    expect(last.status).toBe("ontime");
+    // Running again: on time, or stumbling when a call ran past its budget on a loaded machine.
+    expect(["ontime", "stumbling"], last.text).toContain(last.status);
     const other = tel.at(-1)!.blocks.find((b) => b.name === "Other")!;
     expect(other.status).toBe("ontime");
     // The Python block kept going after the restart: most of the 9 s were served.
