@@ -83,13 +83,23 @@ export function serialProxy(post: (m: SerialRequest) => void): {
 export function serialHub(
   post: (m: SerialReply) => void,
   bridge: SerialBridge = createSerialBridge(),
-): { receive(m: SerialRequest): void; closeAll(): void } {
+): { receive(m: SerialRequest): void; closeAll(): Promise<void> } {
   const handles = new Map<number, SerialHandle>();
+  // Ports closed and still sending their last writes: closeAll waits for them too.
+  const closing = new Set<Promise<void>>();
+  const close = (h: SerialHandle | undefined): void => {
+    if (!h) return;
+    h.close();
+    const c = h.closed?.();
+    if (!c) return;
+    closing.add(c);
+    void c.then(() => closing.delete(c));
+  };
   return {
     receive(m) {
       switch (m.op) {
         case "open":
-          handles.get(m.id)?.close();
+          close(handles.get(m.id));
           handles.set(
             m.id,
             bridge.open({
@@ -111,7 +121,7 @@ export function serialHub(
           handles.get(m.id)?.write(m.data);
           break;
         case "close":
-          handles.get(m.id)?.close();
+          close(handles.get(m.id));
           handles.delete(m.id);
           break;
         case "list":
@@ -122,9 +132,11 @@ export function serialHub(
           break;
       }
     },
-    closeAll() {
-      for (const h of handles.values()) h.close();
+    /** Closes every port; resolves once each has sent what was written to it (or given up). */
+    async closeAll() {
+      for (const h of handles.values()) close(h);
       handles.clear();
+      await Promise.all(closing);
     },
   };
 }

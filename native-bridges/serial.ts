@@ -16,6 +16,8 @@ interface NativePort {
   on(event: "error", fn: (err: Error) => void): void;
   write(data: Uint8Array, cb?: (err: Error | null | undefined) => void): boolean;
   close(cb?: (err: Error | null) => void): void;
+  /** Calls back once the bytes written so far have been handed to the device. */
+  drain(cb: (err: Error | null) => void): void;
   readonly isOpen: boolean;
 }
 
@@ -88,6 +90,31 @@ function describe(err: Error & { code?: string }): string {
   return m;
 }
 
+/** How long a closing port may take to send what was written before it (then it closes anyway). */
+export const SERIAL_DRAIN_MS = 1000;
+
+/**
+ * Closes `p` once its pending writes are out — a block's last words (a hand's neutral pose) must
+ * reach the device even when the host exits right after — and at most SERIAL_DRAIN_MS later.
+ */
+function drainThenClose(p: NativePort): Promise<void> {
+  return new Promise((resolve) => {
+    let done = false;
+    const close = (): void => {
+      if (done) return;
+      done = true;
+      clearTimeout(timer);
+      try {
+        p.close(() => resolve());
+      } catch {
+        resolve();
+      }
+    };
+    const timer = setTimeout(close, SERIAL_DRAIN_MS);
+    p.drain(close);
+  });
+}
+
 function openPort(
   o: SerialOptions & {
     reconnectMs: number;
@@ -99,6 +126,7 @@ function openPort(
   let closed = false;
   let port: (NativePort & { open(cb: (err: Error | null) => void): void }) | undefined;
   let retry: ReturnType<typeof setTimeout> | undefined;
+  let whenClosed: Promise<void> = Promise.resolve();
 
   const scheduleRetry = (reason: string): void => {
     port = undefined;
@@ -172,9 +200,10 @@ function openPort(
       if (retry) clearTimeout(retry);
       const p = port;
       port = undefined;
-      if (p?.isOpen) p.close();
+      if (p?.isOpen) whenClosed = drainThenClose(p);
       o.onStatus("closed");
     },
+    closed: () => whenClosed,
   };
 }
 

@@ -42,7 +42,10 @@ export type SerialStatus = "opening" | "open" | "closed" | "error";
 
 export interface SerialHandle {
   write(data: Uint8Array): void;
+  /** Closes the port once what was written has gone out (see `closed`). */
   close(): void;
+  /** Resolves when the port is closed after `close` (its last writes drained, or given up on). */
+  closed?(): Promise<void>;
 }
 
 export interface SerialBridge {

@@ -274,7 +274,7 @@ export class Host {
     });
     worker.on("exit", (code) => {
       st.exited = true;
-      st.serial?.closeAll();
+      void st.serial?.closeAll();
       st.ble?.closeAll();
       if (!st.stopped && code !== 0)
         this.events.fatal?.(`engine worker '${name}' exited with code ${code}`);
@@ -530,9 +530,10 @@ export class Host {
     await Promise.all(
       [...this.workers.values()].map(async (w) => {
         w.stopped = true;
-        w.serial?.closeAll();
         w.ble?.closeAll();
         if (!w.exited) await w.worker.terminate();
+        // After the worker: its last writes (posted before it stopped) are out before we return.
+        await w.serial?.closeAll();
       }),
     );
   }

@@ -146,7 +146,7 @@ export class SessionHub {
     this.worker.on("error", (e) => this.problem(`the engine crashed: ${errorMessage(e)}`));
     this.worker.on("exit", (code) => {
       this.exited = true;
-      this.serial.closeAll();
+      void this.serial.closeAll();
       this.ble.closeAll();
       for (const w of this.writers.values()) w.closeAll();
       if (code !== 0 && !this.closing) this.problem(`the engine exited (code ${code})`);
@@ -430,9 +430,10 @@ export class SessionHub {
     this.closing = true;
     await Promise.race([this.request({ type: "stop" }), new Promise((r) => setTimeout(r, 2000))]);
     for (const w of this.writers.values()) w.closeAll();
-    this.serial.closeAll();
+    const serialClosed = this.serial.closeAll();
     this.ble.closeAll();
     this.exited = true;
     await this.worker.terminate();
+    await serialClosed;
   }
 }
