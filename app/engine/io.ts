@@ -30,6 +30,44 @@ export interface UdpBridge {
   open(options: UdpOpenOptions): UdpSocketHandle;
 }
 
+/**
+ * TCP (a client today; `listen` for devices that connect to the PC, such as OT Bioelettronica's
+ * Muovi, comes next with the same socket handle). Bytes arrive as the network delivers them:
+ * chunk boundaries mean nothing, so protocols keep their own framing across chunks.
+ */
+export interface TcpSocketHandle {
+  /** Sends bytes (copied; a string goes as ASCII/UTF-8); false, nothing sent, when not open. */
+  write(data: Uint8Array | string): boolean;
+  /**
+   * Closes after what was written has gone out (a last command reaches the peer); no callback
+   * follows, not even `onClose`. Idempotent.
+   */
+  close(): void;
+}
+
+export interface TcpCallbacks {
+  /** The connection is open (local and remote addresses). */
+  onConnect?(local: Endpoint, remote: Endpoint): void;
+  /** Bytes received; `data` is valid during the call only (copy what you keep). */
+  onData(data: Uint8Array): void;
+  /**
+   * Exactly once per connection unless `close()` came first: the connect failed (`wasOpen`
+   * false: refused, timed out, host not found) or the open connection ended (closed by the peer,
+   * reset, an error); `reason` is one line saying what happened and what to check. A connection
+   * is never reopened: the caller connects again.
+   */
+  onClose(reason: string, wasOpen: boolean): void;
+}
+
+export interface TcpConnectOptions {
+  /** A connect not answered within this many ms fails (default 5000). */
+  timeoutMs?: number;
+}
+
+export interface TcpBridge {
+  connect(to: Endpoint, callbacks: TcpCallbacks, options?: TcpConnectOptions): TcpSocketHandle;
+}
+
 export interface SerialOptions {
   path: string;
   baudRate: number;
@@ -274,6 +312,7 @@ export interface PythonBridge {
 /** Every bridge the host could provide (all optional). Issue 6 fills these in. */
 export interface IoBridges {
   udp?: UdpBridge;
+  tcp?: TcpBridge;
   serial?: SerialBridge;
   ble?: BleBridge;
   ros?: RosBridge;

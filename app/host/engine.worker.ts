@@ -21,6 +21,7 @@ import { RealtimeLoop } from "../engine/runtime/loop";
 import { serialProxy } from "../../native-bridges/serial-proxy";
 import { bleProxy } from "../../native-bridges/ble-proxy";
 import { nodeRosBridge } from "../../native-bridges/ros";
+import { nodeTcpBridge } from "../../native-bridges/tcp";
 import { nodeUdpBridge } from "../../native-bridges/udp";
 import { createPythonBridge } from "../../native-bridges/python";
 import { flushWrites, nodeResources } from "./resources";
@@ -110,6 +111,7 @@ async function create(msg: InitMessage): Promise<void> {
     resources: nodeResources(dirname(msg.file)),
     io: {
       udp: nodeUdpBridge(),
+      tcp: nodeTcpBridge(),
       ros: nodeRosBridge(),
       serial: serial.bridge,
       ble: ble.bridge,

@@ -34,6 +34,7 @@ import { EngineSession, type LoopHooks } from "../engine/session";
 import { bleProxy } from "../../native-bridges/ble-proxy";
 import { nodeRosBridge } from "../../native-bridges/ros";
 import { serialProxy } from "../../native-bridges/serial-proxy";
+import { nodeTcpBridge } from "../../native-bridges/tcp";
 import { nodeUdpBridge } from "../../native-bridges/udp";
 import { createPythonBridge } from "../../native-bridges/python";
 import { AllowedFolders, nodeResources } from "./resources";
@@ -306,6 +307,7 @@ function runSession(port: MessagePort): void {
       loadPipeline: parse,
       io: {
         udp: nodeUdpBridge(),
+        tcp: nodeTcpBridge(),
         ros: nodeRosBridge(),
         serial: serial.bridge,
         ble: ble.bridge,
