@@ -10,6 +10,7 @@ export type Layer =
   | "web"
   | "electron"
   | "cli"
+  | "devices"
   | "core-wasm"
   | "tests"
   | "tooling";

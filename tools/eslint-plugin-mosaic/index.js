@@ -22,6 +22,7 @@ export const LAYER_FOLDERS = [
   ["app/web/", "web"],
   ["app/electron/", "electron"],
   ["app/cli/", "cli"],
+  ["app/devices/", "devices"],
   ["core-wasm/", "core-wasm"],
   ["tests/", "tests"],
   ["tools/", "tooling"],
@@ -38,7 +39,9 @@ export const ALLOWED = {
   ui: ["ui", "engine"],
   web: ["web", "ui", "engine", "blocks"],
   electron: ["electron", "host"],
-  cli: ["cli", "host", "engine"],
+  cli: ["cli", "host", "engine", "devices"],
+  // Device simulators (Node programs speaking a device's protocol): the engine's types at most.
+  devices: ["devices", "engine"],
   "core-wasm": ["core-wasm"],
   tests: ["*"],
   tooling: ["*"],

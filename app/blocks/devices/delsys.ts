@@ -1,58 +1,253 @@
 import { z } from "zod";
-import { defineBlock, vectorShape } from "../../engine";
-import { delsysProtocol, TRIGNO_COMMAND_PORT, TRIGNO_SENSORS } from "./delsys-protocol";
+import { BlockConfigError, defineBlock, vectorShape, type BlockContext } from "../../engine";
+import { plural, TextThrottle } from "../shared/text";
+import {
+  DeviceClock,
+  hzText,
+  TRIGNO_COMMAND_PORT,
+  TRIGNO_EMG_PORT,
+  TRIGNO_NATIVE_RATE,
+  TRIGNO_NATIVE_SAMPLES,
+  TRIGNO_SENSORS,
+} from "./delsys-protocol";
+import { delsysProtocol, noTcpMessage, TrignoLink, type TrignoLinkOptions } from "./delsys-link";
 import { pacedDevice, pacingTimer } from "./paced-device";
+
+const sensorNumber = z.number().int().min(1).max(TRIGNO_SENSORS);
 
 const params = z.strictObject({
   Sensors: z
-    .number()
-    .int()
-    .min(1)
-    .max(TRIGNO_SENSORS)
+    .union([
+      sensorNumber,
+      z
+        .array(sensorNumber)
+        .min(1)
+        .max(TRIGNO_SENSORS)
+        .refine((a) => new Set(a).size === a.length, {
+          message: "a sensor is listed twice",
+        }),
+    ])
     .default(TRIGNO_SENSORS)
     .describe(
-      "EMG sensors streamed (the output's width; the original took as many as were paired and " +
-        "selected in its control panel)",
+      "EMG sensors streamed, one channel each: a count N (sensors 1…N) or the sensor numbers " +
+        "(1…16, the TCU's pairing slots) in the order of the output's channels, e.g. " +
+        "[1, 2, 3, 4, 9, 10, 11, 12]",
     ),
   Host: z
     .string()
     .trim()
     .min(1)
     .max(253)
+    .regex(/^[A-Za-z0-9.:_%-]+$/, "expected an IP address or a host name")
     .default("127.0.0.1")
     .describe("The computer running Delsys' Trigno Control Utility (its SDK server)"),
+  Port: z
+    .number()
+    .int()
+    .min(1)
+    .max(65535)
+    .optional()
+    .describe(`The TCU's command port (default ${TRIGNO_COMMAND_PORT})`),
+  EmgPort: z
+    .number()
+    .int()
+    .min(1)
+    .max(65535)
+    .optional()
+    .describe(`The TCU's Avanti EMG data port (default ${TRIGNO_EMG_PORT})`),
 });
+
+type Params = z.output<typeof params>;
+
+/** The selected sensor numbers, in output order. */
+export function selectedSensors(s: Params["Sensors"]): number[] {
+  return typeof s === "number" ? Array.from({ length: s }, (_, i) => i + 1) : [...s];
+}
+
+/** "sensor 3" per channel, for the `channels` action. */
+const channelNames = (sensors: readonly number[]): string[] =>
+  sensors.map((s, i) => `channel ${i + 1}: sensor ${s} (EMG, V)`);
 
 export const Delsys = defineBlock({
   type: "Delsys",
   category: "Devices",
-  summary: "EMG from a Delsys Trigno system: one channel per sensor, paced by a timer.",
+  summary:
+    "EMG from a Delsys Trigno system over the Trigno SDK (TCP): native 1925.926 Hz, or paced by a timer.",
   help:
-    "A Delsys Trigno wireless EMG system, as MOSAIC's Delsys block: paced by one timer input, " +
-    "every tick emits one vector [1, Sensors] with the newest EMG sample of each sensor (its " +
-    "first EMG channel, in volts, as the original). The original took its sensors from its " +
-    "control panel (scan, select, arm); here `Sensors` says how many, so the output's shape is " +
-    "known when the pipeline loads. MOSAIC's form has no Params. The link (Delsys' Trigno SDK " +
-    `over TCP, command port ${TRIGNO_COMMAND_PORT}) comes in a later release: until then the ` +
-    "block says that the device is not reachable and sends zeros, and `mosaic run " +
-    "--simulate-devices` (or the app's Simulate devices switch) replaces it by an EmgSimulator " +
-    "of the same shape and rate.",
+    "A Delsys Trigno wireless EMG system through the Trigno Control Utility's SDK server (TCP, " +
+    `command port ${TRIGNO_COMMAND_PORT}, Avanti EMG data port ${TRIGNO_EMG_PORT}; protocol and ` +
+    "sources in docs/protocols.md, section Delsys Trigno). The block connects, switches the " +
+    "TCU's backwards compatibility and upsampling off, asks which of the selected `Sensors` are " +
+    "paired (an unpaired one is reported and its channel stays 0), sends START and parses the " +
+    "float32 stream (16 sensor slots per sample, volts), one channel per selected sensor in the " +
+    "order listed. **Without an input** it is its own source at the device's rate (" +
+    `${hzText(TRIGNO_NATIVE_RATE)}, ${TRIGNO_NATIVE_SAMPLES} samples every 13.5 ms): what arrives ` +
+    "is emitted at once as one frame, stamped on the device's sample clock (the first batch's " +
+    "last sample at its arrival, then 1 / rate apart, at most one 13.5 ms frame ahead of " +
+    "arrival; re-anchored after a reconnection, the gap counted). **With a timer input** (MOSAIC's form: `Inputs: [timer]`, no Params) each tick " +
+    "emits the oldest waiting sample, repeats the last when none came and zeros while not " +
+    "streaming, as the original. A lost connection is reported and retried (0.5 s, doubling to " +
+    "5 s); STOP is sent when the pipeline stops. Malformed or misaligned data (not finite, " +
+    "beyond ±0.1 V, non-zero in an unpaired slot) is counted and skipped to the next whole " +
+    "sample, a sample cut short by a disconnection is counted as truncated. The original MOSAIC " +
+    "used Delsys' licensed .NET API instead (RF base, its own sensor scan); this block needs " +
+    "only the TCU. Never run against real hardware here: tested against the simulator " +
+    "(`mosaic simulate delsys`). `mosaic run --simulate-devices` replaces it by an EmgSimulator " +
+    "of the same shape and rate. Unavailable in the browser build (no TCP): the status says so.",
   params,
   legacyParams: () => ({}),
   legacyForm: "no Params (16 sensors)",
-  inputs: { min: 1, max: 1, labels: ["timer"] },
+  inputs: { min: 0, max: 1, labels: ["timer"] },
   outputs: ["emg"],
   eventLoop: true,
   views: ["scope", "spider"],
-  panel: "Scope of the sensors; the link's state and samples received.",
+  panel:
+    "Scope of the sensors; the link's state, samples, reconnections, malformed and truncated data.",
   create(ctx, p) {
-    pacingTimer(ctx);
-    return pacedDevice(ctx, {
-      device: "Delsys Trigno",
-      target: `the Trigno Control Utility at ${p.Host}:${TRIGNO_COMMAND_PORT} (Trigno SDK, TCP)`,
-      shape: vectorShape(p.Sensors),
-      port: "emg",
-      protocol: delsysProtocol(p),
-    });
+    const sensors = selectedSensors(p.Sensors);
+    const link: TrignoLinkOptions = {
+      host: p.Host,
+      commandPort: p.Port ?? TRIGNO_COMMAND_PORT,
+      emgPort: p.EmgPort ?? TRIGNO_EMG_PORT,
+      sensors,
+    };
+    if (p.Port !== undefined && p.EmgPort === p.Port) {
+      throw new BlockConfigError(
+        `EmgPort ${p.EmgPort} is the command Port too: the TCU serves them on different ports`,
+        "EmgPort",
+      );
+    }
+    const target = `the Trigno Control Utility at ${p.Host}:${link.commandPort}`;
+    let current: TrignoLink | undefined;
+    const actions = {
+      channels: {
+        label: "Channels",
+        description: "Which sensor each output channel carries",
+        run: () => channelNames(sensors).join("; "),
+      },
+      counts: {
+        label: "Counts",
+        description: "Samples, reconnections, malformed and truncated data, the TCU's banner",
+        run: () => countsText(current),
+      },
+    };
+    if (ctx.inputs.length > 0) {
+      pacingTimer(ctx);
+      const instance = pacedDevice(ctx, {
+        device: "Delsys Trigno",
+        target: `${target} (Trigno SDK, TCP)`,
+        shape: vectorShape(sensors.length),
+        port: "emg",
+        // Two TCU frames: a 1926 Hz timer drains each 13.5 ms frame before the next comes.
+        maxQueue: 2 * (TRIGNO_NATIVE_SAMPLES + 1),
+        protocol: delsysProtocol(link, (l) => (current = l)),
+      });
+      return { ...instance, actions };
+    }
+    return { ...nativeSource(ctx, link, target, (l) => (current = l)), actions };
   },
 });
+
+/** One line of counts, for the action. */
+function countsText(link: TrignoLink | undefined): string {
+  if (!link) return "not started";
+  const c = link.counts;
+  return (
+    `${c.samples} samples at ${hzText(c.rate)}, ${c.reconnections} reconnections, ` +
+    `${c.malformed} malformed (${c.skippedBytes} bytes skipped${c.lastProblem ? `, last: ${c.lastProblem}` : ""}), ` +
+    `${c.truncated} truncated (${c.truncatedBytes} bytes)` +
+    (c.unpaired.length > 0 ? `, not paired: ${c.unpaired.join(", ")}` : "") +
+    (c.banner ? `; TCU: ${c.banner}` : "")
+  );
+}
+
+/** The block without an input: its own source at the device's rate. */
+function nativeSource(
+  ctx: BlockContext,
+  o: TrignoLinkOptions,
+  target: string,
+  onLink: (l: TrignoLink) => void,
+) {
+  if (ctx.declaredRate === undefined) ctx.setDesiredRate(TRIGNO_NATIVE_RATE);
+  const k = o.sensors.length;
+  const out = ctx.output(vectorShape(k), "emg");
+  const clock = new DeviceClock(TRIGNO_NATIVE_RATE);
+  const throttle = new TextThrottle(0.5);
+  let link: TrignoLink | undefined;
+  let phase = "stopped";
+  let lastText = "";
+  let shownGaps = 0;
+
+  const refresh = (): void => {
+    let text = phase;
+    const c = link?.counts;
+    if (c) {
+      if (c.samples > 0) text += ` · ${plural(c.samples, "sample")}`;
+      if (c.reconnections > 0) text += ` · ${plural(c.reconnections, "reconnection")}`;
+      if (clock.gapSamples > 0) text += ` · ${clock.gapSamples} samples lost in gaps`;
+      if (c.malformed > 0) text += ` · ${c.malformed} malformed (${c.skippedBytes} bytes skipped)`;
+      if (c.truncated > 0) text += ` · ${c.truncated} truncated`;
+      if (clock.reanchors > 0) text += ` · re-anchored ${clock.reanchors}×`;
+    }
+    if (text !== lastText) {
+      lastText = text;
+      ctx.setText(text);
+    }
+  };
+
+  const onSamples = (values: Float64Array, n: number): void => {
+    const f = out.frame(n);
+    clock.stamp(ctx.now(), f.t, n);
+    f.v.set(values.subarray(0, n * k));
+    out.emit(f);
+    // A gap (after a reconnection) shows at once; the counts every half second.
+    if (clock.gaps !== shownGaps) {
+      shownGaps = clock.gaps;
+      refresh();
+    } else if (throttle.due(ctx.now())) refresh();
+  };
+
+  refresh();
+  return {
+    start() {
+      const tcp = ctx.io.tcp;
+      if (!tcp) {
+        phase = "TCP not available in the browser build; use --simulate-devices";
+        refresh();
+        ctx.warn(noTcpMessage(target));
+        return;
+      }
+      link = new TrignoLink(ctx, tcp, o, {
+        samples: onSamples,
+        state(_phase, text) {
+          phase = text;
+          refresh();
+        },
+        warn: (m) => ctx.warn(`Delsys Trigno: ${m}`),
+        started(rate) {
+          clock.setRate(rate);
+        },
+        broke() {
+          clock.restart();
+        },
+      });
+      onLink(link);
+      link.open();
+    },
+    stop() {
+      link?.close();
+      phase = "stopped";
+      refresh();
+    },
+    reset() {
+      clock.reset();
+      shownGaps = 0;
+      throttle.reset();
+      refresh();
+    },
+    dispose() {
+      link?.close();
+      link = undefined;
+    },
+  };
+}

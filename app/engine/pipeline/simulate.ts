@@ -134,6 +134,9 @@ function sink(
 const endpoint = (host: unknown, port: unknown): string =>
   `${String(host).includes(":") ? `[${String(host)}]` : String(host)}:${String(port)}`;
 
+/** The Trigno's native EMG rate: 26 samples per 13.5 ms frame (app/blocks/devices/delsys-protocol.ts). */
+const TRIGNO_NATIVE_RATE = 26 / 0.0135;
+
 /** Myo's EMG as the armband gives it: int8 / 128, filtered on board (no hum). */
 const MYO_EMG = { AmplitudeMv: 0.25, NoiseFloorMv: 0.005, HumMv: 0 };
 
@@ -238,8 +241,33 @@ export const SIMULATED_DEVICES: Readonly<Record<string, DeviceRule>> = {
   Delsys: {
     kind: "source",
     network: false,
-    becomes: "EmgSimulator with one channel per sensor on its timer",
-    substitute: (b, env) => emgOnTimer(b, env, p(b).Sensors as number),
+    becomes:
+      "EmgSimulator with one channel per sensor on its timer (without one, a new ScheduledTimer at the Trigno's native 1925.926 Hz)",
+    substitute(b, env) {
+      const sensors = p(b).Sensors as number | number[];
+      const channels = Array.isArray(sensors) ? sensors.length : sensors;
+      if (timerOf(b)) return emgOnTimer(b, env, channels);
+      const clock = env.freshName(`${b.name}_clock`);
+      return {
+        blocks: [
+          {
+            name: clock,
+            type: "ScheduledTimer",
+            params: {},
+            inputs: [],
+            desiredRate: TRIGNO_NATIVE_RATE,
+          },
+          {
+            name: b.name,
+            type: "EmgSimulator",
+            params: { Channels: channels, Seed: seedOf(b.name) },
+            inputs: [clock],
+          },
+        ],
+        ports: { [b.outputs[0]!]: { block: b.name, port: "emg" } },
+        summary: `EmgSimulator, ${channels} channels at ${hz(TRIGNO_NATIVE_RATE)} (a new ScheduledTimer at the Trigno's native rate); gesture keys in the app`,
+      };
+    },
   },
   DLR_ADCBT: {
     kind: "source",
