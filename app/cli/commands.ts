@@ -5,6 +5,7 @@
  *   mosaic format FILE... [--check]    canonical round trip through the editor's document model
  *   mosaic run FILE [options]          live per-block table (or --json lines); Ctrl-C stops cleanly
  *   mosaic bench [options]             the standard performance suite (see `mosaic bench --help`)
+ *   mosaic simulate DEVICE [options]   a device simulator (app/devices/) until Ctrl-C
  */
 import { readFileSync, statSync, writeFileSync } from "node:fs";
 import { dirname, join, resolve } from "node:path";
@@ -16,6 +17,7 @@ import type { Telemetry } from "../engine/runtime/runtime";
 import { Host, webRoot } from "../host/host";
 import { serveStatic } from "../host/web-server";
 import { runBench } from "./bench";
+import { cmdSimulate, simulateHelp } from "./simulate";
 import { renderTable } from "./table";
 
 const VERSION = "0.1.0";
@@ -73,6 +75,10 @@ Usage:
       --data-dir DIR (data and model files, Path logs, Python modules).
   mosaic bench [--duration S] [--warmup S] [--only NAME[,NAME]] [--out DIR] [--quick]
       Runs the standard benchmarks and writes bench/results/*.json and *.md.
+  mosaic simulate DEVICE [options]
+      Runs a device's simulator on this machine, written from its protocol, so that a pipeline
+      can be demonstrated without the hardware; prints where it listens, runs until Ctrl-C.
+${simulateHelp()}
   mosaic --help | --version
 `;
 
@@ -574,9 +580,11 @@ async function dispatch(cmd: string | undefined, rest: string[]): Promise<number
       return cmdWeb(rest);
     case "serve":
       return cmdServe(rest);
+    case "simulate":
+      return cmdSimulate(rest, out, err);
     default:
       err(
-        `mosaic: unknown command '${cmd}' (commands: validate, format, run, web, serve, bench; see mosaic --help)`,
+        `mosaic: unknown command '${cmd}' (commands: validate, format, run, web, serve, bench, simulate; see mosaic --help)`,
       );
       return 2;
   }

@@ -1,0 +1,158 @@
+/**
+ * `mosaic simulate DEVICE [options]`: runs a device simulator (app/devices/) on this machine so
+ * that a pipeline can be demonstrated or tested without the hardware, e.g. the Trigno Control
+ * Utility's SDK server for the Delsys block. Each simulator is one entry of `SIMULATORS` (its
+ * options, its usage line and how to start it); it prints where it listens and what it streams,
+ * and runs until Ctrl-C.
+ */
+import { parseArgs } from "node:util";
+import {
+  TCU_FRAME_INTERVAL,
+  TCU_PORTS,
+  TrignoSimulator,
+  pairedSensors,
+} from "../devices/trigno-simulator";
+
+type OptionSpec = { type: "string" | "boolean"; default?: string | boolean };
+type Values = Record<string, string | boolean | undefined>;
+
+/** A running simulator: what to print, and how to stop it. */
+interface Running {
+  lines: string[];
+  close(): Promise<void>;
+}
+
+interface DeviceSimulator {
+  /** One line for the help. */
+  summary: string;
+  /** Its options as `mosaic simulate DEVICE` takes them (the help's usage line). */
+  usage: string;
+  options: Record<string, OptionSpec>;
+  /** Starts it; throws an Error whose message says what is wrong (a taken port, a bad option). */
+  start(v: Values, log: (line: string) => void): Promise<Running>;
+}
+
+/** A port option: 0…65535 (0: any free port). */
+function portOption(v: Values, name: string, fallback: number): number {
+  const raw = v[name];
+  if (raw === undefined) return fallback;
+  const n = Number(raw);
+  if (typeof raw !== "string" || !/^\d+$/.test(raw) || n > 65535) {
+    throw new Error(`--${name} must be a port number (0 for any free port), not '${String(raw)}'`);
+  }
+  return n;
+}
+
+/** `--sensors 8` (sensors 1…8) or `--sensors 1,3,5`. */
+function sensorsOption(raw: string | boolean | undefined): number | number[] {
+  if (raw === undefined) return 16;
+  const text = String(raw).trim();
+  const parts = text.split(",").map((s) => s.trim());
+  if (parts.some((s) => !/^\d+$/.test(s))) {
+    throw new Error(
+      `--sensors takes a count (1…16) or sensor numbers such as 1,2,5; not '${text}'`,
+    );
+  }
+  const nums = parts.map(Number);
+  const sensors = parts.length === 1 ? nums[0]! : nums;
+  pairedSensors(sensors); // throws with the reason
+  return sensors;
+}
+
+const hz = (x: number): string => `${x.toFixed(3)} Hz`;
+
+export const SIMULATORS: Record<string, DeviceSimulator> = {
+  delsys: {
+    summary:
+      "Delsys Trigno Control Utility SDK server: command port, Avanti EMG (16 × float32, 1925.926 Hz) and AUX ports",
+    usage:
+      "[--sensors N|LIST] [--host ADDR] [--command-port P] [--emg-port P] [--aux-port P] [--seed S] [--verbose]",
+    options: {
+      sensors: { type: "string" },
+      host: { type: "string", default: "127.0.0.1" },
+      "command-port": { type: "string" },
+      "emg-port": { type: "string" },
+      "aux-port": { type: "string" },
+      seed: { type: "string", default: "1" },
+      verbose: { type: "boolean", default: false },
+    },
+    async start(v, log) {
+      const sensors = sensorsOption(v.sensors);
+      const seed = Number(v.seed);
+      if (!Number.isInteger(seed))
+        throw new Error(`--seed must be an integer, not '${String(v.seed)}'`);
+      const sim = await TrignoSimulator.start({
+        host: String(v.host),
+        commandPort: portOption(v, "command-port", TCU_PORTS.command),
+        emgPort: portOption(v, "emg-port", TCU_PORTS.emg),
+        auxPort: portOption(v, "aux-port", TCU_PORTS.aux),
+        sensors,
+        seed,
+        ...(v.verbose ? { log } : {}),
+      });
+      const ports = sim.ports;
+      const paired = [...sim.paired].sort((a, b) => a - b);
+      return {
+        lines: [
+          `Trigno simulator listening on ${sim.host}: command port ${ports.command}, EMG port ${ports.emg}, AUX port ${ports.aux}`,
+          `${paired.length} Avanti sensor${paired.length === 1 ? "" : "s"} paired (${paired.join(", ")}); after START it streams ` +
+            `EMG at ${hz(sim.rate)} (${sim.samplesPerFrame} samples × 16 float32 every ${TCU_FRAME_INTERVAL * 1000} ms; ` +
+            `2000 Hz with BACKWARDS COMPATIBILITY ON) and AUX at ${hz(2 / TCU_FRAME_INTERVAL)}, seed ${seed}`,
+          "Ctrl-C stops it.",
+        ],
+        close: () => sim.close(),
+      };
+    },
+  },
+};
+
+/** The help's lines for `mosaic simulate`. */
+export function simulateHelp(): string {
+  return Object.entries(SIMULATORS)
+    .map(([name, s]) => `  mosaic simulate ${name} ${s.usage}\n      ${s.summary}`)
+    .join("\n");
+}
+
+/** `mosaic simulate DEVICE [options]`; resolves with the exit code after Ctrl-C. */
+export async function cmdSimulate(
+  args: string[],
+  out: (s: string) => void,
+  err: (s: string) => void,
+): Promise<number> {
+  const [device, ...rest] = args;
+  const names = Object.keys(SIMULATORS).join(", ");
+  const sim = device === undefined ? undefined : SIMULATORS[device];
+  if (!sim) {
+    err(
+      device === undefined
+        ? `usage: mosaic simulate DEVICE [options] (devices: ${names})`
+        : `mosaic simulate: no simulator for '${device}' (devices: ${names})`,
+    );
+    return 2;
+  }
+  const { values, positionals } = parseArgs({
+    args: rest,
+    options: sim.options,
+    allowPositionals: true,
+  });
+  if (positionals.length > 0) {
+    err(
+      `mosaic simulate ${device}: unexpected '${positionals[0]}' (usage: mosaic simulate ${device} ${sim.usage})`,
+    );
+    return 2;
+  }
+  let running: Running;
+  try {
+    running = await sim.start(values as Values, (l) => out(`  ${l}`));
+  } catch (e) {
+    err(`mosaic simulate ${device}: ${(e as Error).message}`);
+    return (e as Error).message.includes("in use") ? 1 : 2;
+  }
+  for (const l of running.lines) out(l);
+  await new Promise<void>((r) => {
+    process.once("SIGINT", r);
+    process.once("SIGTERM", r);
+  });
+  await running.close();
+  return 0;
+}
