@@ -23,6 +23,7 @@ GENERATORS=(
   "core-wasm/learn/tests/fixtures/gen_lda.py:lda.json"
   "app/blocks/signal/fixtures/gen_dds.py:dds.json"
   "app/blocks/signal/fixtures/gen_envelope.py:envelope_5hz.csv"
+  "app/blocks/kinematics/fixtures/gen_body_rig.py:body_rig.json"
 )
 
 # uv as installed by scripts/setup.sh (pip --user: `python3 -m uv`), or on PATH.

@@ -27,13 +27,14 @@ const CATEGORY_ORDER: Record<BlockCategory, number> = {
   Sources: 1,
   "Signal processing": 2,
   Features: 3,
-  "Flow control": 4,
-  Learning: 5,
-  Control: 6,
-  Communication: 7,
-  Devices: 8,
-  Recording: 9,
-  Testing: 10,
+  Kinematics: 4,
+  "Flow control": 5,
+  Learning: 6,
+  Control: 7,
+  Communication: 8,
+  Devices: 9,
+  Recording: 10,
+  Testing: 11,
 };
 
 /** Mirrors the pipeline loader (app/engine/pipeline/loader.ts). */

@@ -21,6 +21,7 @@ import { WaveformLength } from "./features/waveform-length";
 import { WillisonAmplitude } from "./features/willison-amplitude";
 import { ZeroCrossings } from "./features/zero-crossings";
 import { ArtifactRejection } from "./flow/artifact-rejection";
+import { BodyRig } from "./kinematics/body-rig";
 import { BufferBlock } from "./flow/buffer";
 import { ChannelSelector } from "./flow/channel-selector";
 import { Joiner } from "./flow/joiner";
@@ -96,6 +97,8 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   Dasdv,
   WillisonAmplitude,
   FeatureSet,
+  // Kinematics
+  BodyRig,
   // Flow control
   SlidingWindow,
   ArtifactRejection,

@@ -323,6 +323,28 @@ const SETUPS: Record<string, Setup | Setup[]> = {
       inputs: [vec(3)],
     },
   ],
+  BodyRig: [
+    { params: {}, inputs: [vec(12)] },
+    {
+      // Two inputs, Euler angles, the Trigger on the second; every 7th event (NaN) is refused.
+      params: {
+        Orientation: "euler",
+        EulerSequence: "xyz",
+        Output: "matrix",
+        Trigger: "in1",
+        Links: [
+          { Name: "Torso", Offset: [0, 0, 0.5], SensorToSegmentEuler: [0, 90, 0] },
+          { Name: "Arm", Parent: "Torso", Length: 0.3, Input: "in1", Channel: 1 },
+          { Name: "Hand", Parent: "Arm", Length: 0.1, Axis: "-z", Input: "in1" },
+        ],
+      },
+      inputs: [vec(3), vec(7)],
+      pattern: [0, 1, 1, 0, 1, 0, 0, 1],
+      values: (i, port, size) =>
+        i % 7 === 3 ? new Array<number>(size).fill(NaN) : smooth(i, port, size),
+    },
+    { params: { Links: [{ Name: "Shank", Length: 0.4, Axis: "-y" }] }, inputs: [vec(4)] },
+  ],
   SlidingWindow: [
     { params: { Length: 5, Step: 2 }, inputs: [vec(3)] },
     { params: { Length: 4, WindowFunction: "hann" }, inputs: [vec(2)] },

@@ -17,6 +17,7 @@ export type BlockCategory =
   | "Sources"
   | "Signal processing"
   | "Features"
+  | "Kinematics"
   | "Flow control"
   | "Learning"
   | "Control"
