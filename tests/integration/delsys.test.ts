@@ -152,7 +152,7 @@ describe("Delsys ↔ Trigno simulator on loopback", () => {
     );
   });
 
-  test("timer-paced (the original's form): each tick takes the oldest waiting sample, in sequence", async () => {
+  test("timer-paced (the original's form): each tick takes the oldest waiting sample, in sequence; zeros while lost", async () => {
     const sim = await simulator({ sensors: 2, seed: 5 });
     const h = await block({ Sensors: [2, 1], ...ports(sim) }, 1925.926);
     h.start();
@@ -176,6 +176,15 @@ describe("Delsys ↔ Trigno simulator on loopback", () => {
     }
     expect(k0).toBeGreaterThanOrEqual(0);
     expectSamples(h, [2, 1], 5, 0, 40, k0);
+    // While the link is lost, ticks give zeros (as the original while not streaming).
+    sim.dropConnections();
+    await until(() => /^lost/.test(h.text), "lost");
+    h.push(Frame.from(EMPTY_SHAPE, [1001, 1002], [[], []]));
+    expect(rows(h).slice(40)).toEqual([
+      [0, 0],
+      [0, 0],
+    ]);
+    await until(() => /^streaming/.test(h.text), "streaming again");
   });
 
   test("a killed simulator is reported; a restarted one is found again and the stream goes on", async () => {
