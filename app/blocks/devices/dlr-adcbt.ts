@@ -32,13 +32,21 @@ export const DLR_ADCBT = defineBlock({
   summary: "Analog channels from the DLR ADC/BT converter over a serial port, paced by a timer.",
   help:
     "The DLR's ADC/BT analog-to-digital converter (e.g. force or FMG sensors) on a serial port " +
-    `(Bluetooth SPP or USB, ${DLR_BAUD_RATE} Bd), as MOSAIC's DLR_ADCBT: paced by one timer ` +
-    "input, every tick emits one vector [1, Channels] with the newest frame's values in volts " +
-    "(5 · raw / 4000, as the original). MOSAIC's positional form is `[COMport, numChannels]` " +
-    `(both optional; ${DLR_DEFAULT_CHANNELS} channels by default). The converter's protocol ` +
-    "comes in a later release: until then the block says that the device is not reachable and " +
-    "sends zeros, and `mosaic run --simulate-devices` (or the app's Simulate devices switch) " +
-    "replaces it by a simulated signal of the same shape and rate.",
+    `(Bluetooth SPP or USB, ${DLR_BAUD_RATE} Bd 8N1), as MOSAIC's DLR_ADCBT: when the pipeline ` +
+    "starts it sends the board the channel count and the start command, then reads its frames " +
+    "(`AA 7A`, the length byte, one big-endian 16-bit value per channel, `FF FF`; " +
+    "docs/protocols.md). Paced by one timer input: every tick emits one vector [1, Channels] in " +
+    "volts (5 · raw / 4000, as the original) with the oldest frame not yet emitted (the newest 15 " +
+    "are kept; older ones are dropped and counted), the last one again when no frame came, and " +
+    "zeros while the board is not streaming. Malformed frames (a wrong length byte, no `FF FF` " +
+    "end) are dropped, counted in the status and the reader re-synchronises on the next start; " +
+    "when the port disappears the status says `lost … reconnecting`, the port is reopened every " +
+    "second and the board configured again. MOSAIC's positional form is " +
+    `[COMport, numChannels] (both optional; ${DLR_DEFAULT_CHANNELS} channels by default). Needs the ` +
+    "desktop app or `mosaic run` (the browser build has no serial ports: the status says so and " +
+    "the rest of the pipeline runs). `mosaic simulate dlr-adcbt --port PATH` plays the board on " +
+    "a serial device (one end of a socat pty pair); `mosaic run --simulate-devices` replaces " +
+    "the block by a simulated signal of the same shape and rate.",
   params,
   legacyParams(args) {
     const port = (args[0] ?? "").trim();
@@ -58,7 +66,8 @@ export const DLR_ADCBT = defineBlock({
   outputs: ["analog"],
   eventLoop: true,
   views: ["scope"],
-  panel: "Scope of the channels; the link's state and frames received.",
+  panel:
+    "Scope of the channels; the link's state, samples received, malformed frames and bytes skipped, reconnections.",
   create(ctx, p) {
     pacingTimer(ctx);
     const port = p.Port ? `serial port ${p.Port}` : "a serial port (none chosen: set Port)";
