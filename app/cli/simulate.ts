@@ -12,6 +12,7 @@ import {
   TrignoSimulator,
   pairedSensors,
 } from "../devices/trigno-simulator";
+import { dlrAdcBtSimulatorOptions, startDlrAdcBtSimulator } from "../devices/dlr-adcbt-simulator";
 
 type OptionSpec = { type: "string" | "boolean"; default?: string | boolean };
 type Values = Record<string, string | boolean | undefined>;
@@ -99,6 +100,33 @@ export const SIMULATORS: Record<string, DeviceSimulator> = {
             `EMG at ${hz(sim.rate)} (${sim.samplesPerFrame} samples × 16 float32 every ${TCU_FRAME_INTERVAL * 1000} ms; ` +
             `2000 Hz with BACKWARDS COMPATIBILITY ON) and AUX at ${hz(2 / TCU_FRAME_INTERVAL)}, seed ${seed}`,
           "Ctrl-C stops it.",
+        ],
+        close: () => sim.close(),
+      };
+    },
+  },
+  "dlr-adcbt": {
+    summary:
+      "DLR ADC/BT converter on a serial device (one end of a socat pty pair): answers the channel count and start, then streams frames of 12-bit channels",
+    usage: "--port PATH [--channels N] [--rate HZ] [--seed S] [--faults N] [--verbose]",
+    options: {
+      port: { type: "string" },
+      channels: { type: "string" },
+      rate: { type: "string" },
+      seed: { type: "string" },
+      faults: { type: "string" },
+      verbose: { type: "boolean", default: false },
+    },
+    async start(v, log) {
+      const sim = await startDlrAdcBtSimulator({
+        ...dlrAdcBtSimulatorOptions(v),
+        ...(v.verbose ? { log } : {}),
+      });
+      return {
+        lines: [
+          `DLR ADC/BT simulator on ${sim.path}: waits for the channel count and start, then streams ` +
+            `${sim.rate} frames/s (${sim.channels} channels until told otherwise), seed ${sim.seed}`,
+          "Point DLR_ADCBT's Port at the other end of the pty pair. Ctrl-C stops it.",
         ],
         close: () => sim.close(),
       };

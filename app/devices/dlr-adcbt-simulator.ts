@@ -321,3 +321,53 @@ class Board implements DlrAdcBtSimulator {
 function hex(b: Uint8Array): string {
   return [...b].map((x) => x.toString(16).toUpperCase().padStart(2, "0")).join(" ");
 }
+
+/** A whole or decimal number option of `mosaic simulate dlr-adcbt`, checked. */
+function numberOption(
+  v: Record<string, string | boolean | undefined>,
+  name: string,
+  integer: boolean,
+): number | undefined {
+  const raw = v[name];
+  if (raw === undefined) return undefined;
+  const n = Number(raw);
+  if (
+    typeof raw !== "string" ||
+    raw.trim() === "" ||
+    !Number.isFinite(n) ||
+    (integer && !Number.isInteger(n))
+  ) {
+    throw new Error(
+      `--${name} must be ${integer ? "a whole number" : "a number"}, not '${String(raw)}'`,
+    );
+  }
+  return n;
+}
+
+/**
+ * The simulator's options from `mosaic simulate dlr-adcbt`'s (`--port PATH [--channels N]
+ * [--rate HZ] [--seed S] [--faults N]`); throws an Error saying what is wrong.
+ */
+export function dlrAdcBtSimulatorOptions(
+  v: Record<string, string | boolean | undefined>,
+): DlrAdcBtSimulatorOptions {
+  const path = v.port;
+  if (typeof path !== "string" || path.trim() === "") {
+    throw new Error(
+      "--port PATH is required: the serial device the board is on, e.g. one end of a pty pair " +
+        "made by `socat pty,raw,echo=0,link=/tmp/dlr pty,raw,echo=0,link=/tmp/board` " +
+        "(then --port /tmp/board here and Port: /tmp/dlr in the pipeline)",
+    );
+  }
+  const o: DlrAdcBtSimulatorOptions = { path };
+  const channels = numberOption(v, "channels", true);
+  const rate = numberOption(v, "rate", false);
+  const seed = numberOption(v, "seed", true);
+  const every = numberOption(v, "faults", true);
+  if (channels !== undefined) o.channels = channels;
+  if (rate !== undefined) o.rate = rate;
+  if (seed !== undefined) o.seed = seed;
+  if (every !== undefined) o.faults = { every };
+  checkOptions(o);
+  return o;
+}

@@ -5,18 +5,22 @@
  * logged is the simulator's frame k in volts exactly; malformed frames are counted in its status
  * and the stream resumes; the simulator closing its side (silence) is reported and recovered
  * when it comes back; an unplug (the pty pair disappears) is reported and the port reopened; a
- * missing port says so while the rest of the pipeline runs.
+ * missing port says so while the rest of the pipeline runs. Then `mosaic simulate dlr-adcbt` as a
+ * child process with `mosaic run` of pipelines/devices/dlr-adcbt.yaml, and the example under
+ * --simulate-devices.
  */
 import { spawn, spawnSync, type ChildProcess } from "node:child_process";
+import { createSocket } from "node:dgram";
 import { existsSync, readFileSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
+import { createInterface } from "node:readline";
 import { afterEach, describe, expect, test } from "vitest";
 import {
   dlrAdcBtVolts,
   startDlrAdcBtSimulator,
   type DlrAdcBtSimulator,
 } from "../../app/devices/dlr-adcbt-simulator";
-import { jsonLines, requireBuild, runCli, startCli, tempDir } from "./helpers";
+import { jsonLines, requireBuild, ROOT, runCli, startCli, tempDir } from "./helpers";
 
 const haveSocat = spawnSync("socat", ["-V"]).status === 0;
 const SEED = 7;
@@ -250,5 +254,66 @@ Sine: { Type: SinGenerator, Inputs: [Timer], Params: [2], Path: ${JSON.stringify
         String(m.message).includes("cannot open"),
     );
     expect(warnings.length).toBeGreaterThan(0);
+  }, 60_000);
+
+  test("mosaic simulate dlr-adcbt + mosaic run pipelines/devices/dlr-adcbt.yaml", async () => {
+    requireBuild();
+    const dir = tempDir("mosaic-dlr-");
+    await ptyPair(dir);
+    const sim = startCli(["simulate", "dlr-adcbt", "--port", join(dir, "board"), "--verbose"]);
+    children.push(sim);
+    const lines: string[] = [];
+    createInterface({ input: sim.stdout! }).on("line", (l) => lines.push(l));
+    await waitFor(() => lines.length >= 2, 15_000, "the simulator's banner");
+    expect(lines[0]).toBe(
+      `DLR ADC/BT simulator on ${join(dir, "board")}: waits for the channel count and start, then streams 100 frames/s (10 channels until told otherwise), seed 1`,
+    );
+    const rx = createSocket("udp4");
+    let datagrams = 0;
+    rx.on("message", () => datagrams++);
+    await new Promise<void>((r) => rx.bind(0, "127.0.0.1", r));
+    const file = join(dir, "example.yaml");
+    writeFileSync(
+      file,
+      readFileSync(join(ROOT, "pipelines/devices/dlr-adcbt.yaml"), "utf8")
+        .replace("Port: /tmp/dlr,", `Port: ${JSON.stringify(join(dir, "dev"))},`)
+        .replace("Port: 5005", `Port: ${rx.address().port}`),
+    );
+    const r = runCli(["run", file, "--duration", "3", "--json"], { timeoutMs: 60_000 });
+    expect(r.code, r.stderr).toBe(0);
+    expect(statusTexts(r.stdout, "Forces").some((t) => /^streaming from /.test(t))).toBe(true);
+    const summary = jsonLines(r.stdout).find((l) => l.type === "summary") as
+      { blocks: { name: string; events: number }[] } | undefined;
+    expect(summary!.blocks.find((b) => b.name === "ToScene")!.events).toBeGreaterThan(250);
+    await waitFor(() => datagrams > 100, 5000, "the Sender's datagrams");
+    rx.close();
+    expect(lines.some((l) => l.includes("channel count: 4 (frames of 16 bytes)"))).toBe(true);
+    sim.kill("SIGINT");
+    const code = await new Promise<number | null>((res) => sim.on("exit", (c) => res(c)));
+    expect(code).toBe(0);
+
+    const missing = runCli(["simulate", "dlr-adcbt"]);
+    expect(missing.code).toBe(2);
+    expect(missing.stderr.trim()).toMatch(/^mosaic simulate dlr-adcbt: --port PATH is required: /);
+    const bad = runCli(["simulate", "dlr-adcbt", "--port", join(dir, "board"), "--rate", "fast"]);
+    expect([bad.code, bad.stderr.trim()]).toEqual([
+      2,
+      "mosaic simulate dlr-adcbt: --rate must be a number, not 'fast'",
+    ]);
+    const none = runCli(["simulate", "dlr-adcbt", "--port", join(dir, "nothing")]);
+    expect(none.code).toBe(2);
+    expect(none.stderr.trim()).toMatch(
+      new RegExp(`^mosaic simulate dlr-adcbt: cannot open ${join(dir, "nothing")}: `),
+    );
+  }, 90_000);
+
+  test("the example under --simulate-devices", () => {
+    requireBuild();
+    const r = runCli(
+      ["run", "pipelines/devices/dlr-adcbt.yaml", "--simulate-devices", "--duration", "1.5"],
+      { timeoutMs: 60_000 },
+    );
+    expect(r.code, r.stderr).toBe(0);
+    expect(r.stderr).toMatch(/block 'Forces' \(DLR_ADCBT\) simulated by SinGenerator, 4 channels/);
   }, 60_000);
 });
