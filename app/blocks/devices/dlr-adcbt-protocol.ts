@@ -176,7 +176,8 @@ class DlrLink {
    * Every half second while the link is not closed: a board that sent no frame for
    * DLR_SILENCE_S (switched off, out of radio range, restarted) is reported lost, and while the
    * port is open without frames the configuration goes again every second (a board that was
-   * restarted waits for it).
+   * restarted waits for it). Also while lost: after a failed write the port may still be open
+   * (the bridge drops writes to a closed one).
    */
   private watch(): void {
     const check = (now: number): void => {
@@ -189,7 +190,7 @@ class DlrLink {
         this.describe();
       }
       if (
-        (this.phase === "configured" || this.phase === "silent") &&
+        (this.phase === "configured" || this.phase === "silent" || this.phase === "lost") &&
         now - this.lastConfig >= DLR_RECONNECT_MS / 1000
       ) {
         this.configure();
