@@ -2,7 +2,7 @@
  * The TCP bridge on real loopback sockets: bytes both ways across chunk boundaries, a refused
  * connect, a peer that closes or resets, and a caller's close that still delivers its last write.
  */
-import { createServer, type Server, type Socket } from "node:net";
+import { createConnection, createServer, type Server, type Socket } from "node:net";
 import { afterEach, describe, expect, test } from "vitest";
 import type { TcpSocketHandle } from "../app/engine/io";
 import { describeTcpError, nodeTcpBridge } from "./tcp";
@@ -154,6 +154,102 @@ describe("nodeTcpBridge", () => {
     );
     expect(describeTcpError(new Error("boom"), at, true)).toBe(
       "connection to [::1]:50040 failed: boom",
+    );
+  });
+});
+
+describe("nodeTcpBridge.listen", () => {
+  /** A server on an ephemeral loopback port: resolves with its handle, its port and what it saw. */
+  async function listening() {
+    const seen: string[] = [];
+    const data: number[] = [];
+    const peers: { remote: number; write: (s: string) => boolean }[] = [];
+    let port = 0;
+    const srv = nodeTcpBridge().listen!(
+      { host: "127.0.0.1", port: 0 },
+      {
+        onListening: (l) => (port = l.port),
+        onPeer: (remote, peer) => {
+          peers.push({ remote: remote.port, write: (s) => peer.write(s) });
+          seen.push(`peer ${remote.host}`);
+          return {
+            onData: (d) => data.push(...d),
+            onClose: (reason, wasOpen) => seen.push(`close ${wasOpen}: ${reason}`),
+          };
+        },
+        onError: (r) => seen.push(`error: ${r}`),
+      },
+    );
+    cleanup.push(() => srv.close());
+    await until(() => port > 0);
+    return { srv, port: () => port, seen, data, peers };
+  }
+
+  /** A client socket (node:net) to the port; resolves once connected. */
+  async function client(port: number): Promise<{ s: Socket; got: number[] }> {
+    const got: number[] = [];
+    const s = createConnection({ host: "127.0.0.1", port });
+    s.on("data", (b) => got.push(...b));
+    s.on("error", () => {});
+    cleanup.push(() => s.destroy());
+    await new Promise<void>((r) => s.once("connect", () => r()));
+    return { s, got };
+  }
+
+  test("accepts a peer, reports its address, bytes both ways; the peer's end is one onClose", async () => {
+    const l = await listening();
+    const c = await client(l.port());
+    await until(() => l.peers.length === 1);
+    expect(l.peers[0]!.remote).toBe(c.s.localPort);
+    expect(l.seen[0]).toBe("peer 127.0.0.1");
+    expect(l.peers[0]!.write("\x09")).toBe(true);
+    await until(() => c.got.length === 1);
+    expect(c.got).toEqual([9]);
+    const all = Buffer.alloc(5000);
+    for (let i = 0; i < all.length; i++) all[i] = (i * 13) & 255;
+    for (let at = 0; at < all.length; at += 777) c.s.write(all.subarray(at, at + 777));
+    await until(() => l.data.length === 5000);
+    expect(l.data.every((v, i) => v === ((i * 13) & 255))).toBe(true);
+    c.s.end();
+    await until(() => l.seen.length === 2);
+    expect(l.seen[1]).toMatch(/^close true: 127\.0\.0\.1:\d+ closed the connection$/);
+  });
+
+  test("a new peer replaces the current one (its onClose says so); close() ends both sides", async () => {
+    const l = await listening();
+    const a = await client(l.port());
+    await until(() => l.peers.length === 1);
+    const aPort = a.s.localPort;
+    let aClosed = false;
+    a.s.on("close", () => (aClosed = true));
+    const b = await client(l.port());
+    await until(() => l.peers.length === 2 && aClosed);
+    // The old peer's end comes first, then the new peer.
+    expect(l.seen[2]).toBe("peer 127.0.0.1");
+    expect(l.seen[1]).toMatch(
+      new RegExp(
+        `^close true: 127\\.0\\.0\\.1:${aPort} was replaced by a new connection from 127\\.0\\.0\\.1:${b.s.localPort}$`,
+      ),
+    );
+    let bClosed = false;
+    b.s.on("close", () => (bClosed = true));
+    l.srv.close();
+    await until(() => bClosed);
+    expect(l.seen).toHaveLength(3); // no callback after close()
+    expect(l.peers[1]!.write("x")).toBe(false);
+  });
+
+  test("a port in use is one onError naming the port and what to do", async () => {
+    const l = await listening();
+    const errors: string[] = [];
+    const again = nodeTcpBridge().listen!(
+      { host: "127.0.0.1", port: l.port() },
+      { onPeer: () => ({ onData: () => {}, onClose: () => {} }), onError: (r) => errors.push(r) },
+    );
+    cleanup.push(() => again.close());
+    await until(() => errors.length === 1);
+    expect(errors[0]).toBe(
+      `cannot listen at 127.0.0.1:${l.port()}: the port is in use (EADDRINUSE) — another program (or another block) listens there; choose another Port or stop it`,
     );
   });
 });

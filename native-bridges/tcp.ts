@@ -9,13 +9,19 @@
  *
  * Errors never throw into the block: they come back through `onClose` (connection refused, host
  * not found, timed out, reset by the peer).
+ *
+ * A server (`listen`) accepts one peer at a time, with the same handle and callbacks; a new peer
+ * replaces the current one (a device reconnecting after a dropped Wi-Fi link leaves a dead
+ * connection behind that would otherwise hold the place).
  */
-import { connect as netConnect, isIP, type Socket } from "node:net";
+import { connect as netConnect, createServer, isIP, type Server, type Socket } from "node:net";
 import type {
   Endpoint,
   TcpBridge,
   TcpCallbacks,
   TcpConnectOptions,
+  TcpListenCallbacks,
+  TcpServerHandle,
   TcpSocketHandle,
 } from "../app/engine/io";
 
@@ -67,10 +73,17 @@ class NodeTcpSocket implements TcpSocketHandle {
     private readonly to: Endpoint,
     private readonly cb: TcpCallbacks,
     options: TcpConnectOptions,
+    accepted?: Socket,
   ) {
     const timeoutMs = options.timeoutMs ?? CONNECT_TIMEOUT_MS;
-    this.socket = netConnect({ host: to.host, port: to.port });
+    this.socket = accepted ?? netConnect({ host: to.host, port: to.port });
+    this.open = accepted !== undefined;
     this.socket.setNoDelay(true);
+    if (accepted) this.listenTo(to);
+    else this.connectTo(to, timeoutMs);
+  }
+
+  private connectTo(to: Endpoint, timeoutMs: number): void {
     this.socket.setTimeout(timeoutMs);
     this.socket.on("timeout", () => {
       if (this.open) return;
@@ -88,6 +101,10 @@ class NodeTcpSocket implements TcpSocketHandle {
         { host: s.remoteAddress ?? to.host, port: s.remotePort ?? to.port },
       );
     });
+    this.listenTo(to);
+  }
+
+  private listenTo(to: Endpoint): void {
     this.socket.on("data", (buf: Buffer) => {
       if (this.closed) return;
       this.cb.onData(new Uint8Array(buf.buffer, buf.byteOffset, buf.length));
@@ -117,6 +134,16 @@ class NodeTcpSocket implements TcpSocketHandle {
     }
   }
 
+  /** The peer's address. */
+  get remote(): Endpoint {
+    return this.to;
+  }
+
+  /** Ends the connection now, reporting `reason` through onClose (a server's replaced peer). */
+  drop(reason: string): void {
+    this.end(reason);
+  }
+
   write(data: Uint8Array | string): boolean {
     if (this.closed || !this.open) return false;
     // A copy: callers reuse their buffers.
@@ -140,11 +167,91 @@ class NodeTcpSocket implements TcpSocketHandle {
   }
 }
 
+/** One line for a server that cannot listen. */
+export function describeListenError(err: unknown, at: Endpoint): string {
+  const e = err as NodeJS.ErrnoException;
+  const where = showEndpoint(at);
+  switch (e?.code) {
+    case "EADDRINUSE":
+      return `cannot listen at ${where}: the port is in use (EADDRINUSE) — another program (or another block) listens there; choose another Port or stop it`;
+    case "EACCES":
+      return `cannot listen at ${where}: permission denied (EACCES) — ports below 1024 need privileges; choose a Port of 1024 or more`;
+    case "EADDRNOTAVAIL":
+      return `cannot listen at ${where}: the address is not one of this machine's (EADDRNOTAVAIL)`;
+    default:
+      return `cannot listen at ${where}: ${e instanceof Error ? e.message : String(err)}`;
+  }
+}
+
+/** A server that accepts one peer at a time (see the file comment). */
+class NodeTcpServer implements TcpServerHandle {
+  private readonly server: Server;
+  private peer: NodeTcpSocket | undefined;
+  private closed = false;
+
+  constructor(
+    private readonly at: Endpoint,
+    private readonly cb: TcpListenCallbacks,
+  ) {
+    this.server = createServer((s) => this.accept(s));
+    this.server.on("error", (err) => {
+      if (this.closed) return;
+      this.close();
+      this.cb.onError(describeListenError(err, at));
+    });
+    this.server.listen({ host: at.host, port: at.port, exclusive: true }, () => {
+      if (this.closed) return;
+      const a = this.server.address();
+      const port = a !== null && typeof a === "object" ? a.port : at.port;
+      this.cb.onListening?.({ host: at.host, port });
+    });
+  }
+
+  private accept(socket: Socket): void {
+    if (this.closed) {
+      socket.destroy();
+      return;
+    }
+    const remote = { host: socket.remoteAddress ?? "", port: socket.remotePort ?? 0 };
+    const old = this.peer;
+    // The owner's callbacks for this peer, known once onPeer has returned (events come later).
+    const inner: { cb?: Omit<TcpCallbacks, "onConnect"> } = {};
+    const handle = new NodeTcpSocket(
+      remote,
+      {
+        onData: (d) => inner.cb?.onData(d),
+        onClose: (reason, wasOpen) => {
+          if (this.peer === handle) this.peer = undefined;
+          inner.cb?.onClose(reason, wasOpen);
+        },
+      },
+      {},
+      socket,
+    );
+    this.peer = handle;
+    old?.drop(
+      `${showEndpoint(old.remote)} was replaced by a new connection from ${showEndpoint(remote)}`,
+    );
+    inner.cb = this.cb.onPeer(remote, handle);
+  }
+
+  close(): void {
+    if (this.closed) return;
+    this.closed = true;
+    this.peer?.close();
+    this.peer = undefined;
+    this.server.close();
+  }
+}
+
 /** The TCP bridge the Node host gives its engine workers. */
 export function nodeTcpBridge(): TcpBridge {
   return {
     connect(to: Endpoint, callbacks: TcpCallbacks, options: TcpConnectOptions = {}) {
       return new NodeTcpSocket(to, callbacks, options);
+    },
+    listen(at: Endpoint, callbacks: TcpListenCallbacks) {
+      return new NodeTcpServer(at, callbacks);
     },
   };
 }

@@ -31,9 +31,9 @@ export interface UdpBridge {
 }
 
 /**
- * TCP (a client today; `listen` for devices that connect to the PC, such as OT Bioelettronica's
- * Muovi, comes next with the same socket handle). Bytes arrive as the network delivers them:
- * chunk boundaries mean nothing, so protocols keep their own framing across chunks.
+ * TCP: a client (`connect`) or a server for devices that connect to the PC, such as OT
+ * Bioelettronica's Muovi (`listen`), with the same socket handle. Bytes arrive as the network
+ * delivers them: chunk boundaries mean nothing, so protocols keep their own framing across chunks.
  */
 export interface TcpSocketHandle {
   /** Sends bytes (copied; a string goes as ASCII/UTF-8); false, nothing sent, when not open. */
@@ -64,8 +64,29 @@ export interface TcpConnectOptions {
   timeoutMs?: number;
 }
 
+/** What a server tells its owner (`TcpBridge.listen`). */
+export interface TcpListenCallbacks {
+  /** Listening at `local` (the port chosen when 0 was asked). */
+  onListening?(local: Endpoint): void;
+  /**
+   * A peer connected (one at a time: a new peer replaces the current one, whose `onClose` says
+   * so, as a device that reconnects after a dropped link may leave a dead connection behind).
+   * Returns the callbacks of this connection; `peer` writes to it and closes it.
+   */
+  onPeer(remote: Endpoint, peer: TcpSocketHandle): Omit<TcpCallbacks, "onConnect">;
+  /** The server could not listen (port taken, address not here) or failed: one line; it is closed. */
+  onError(reason: string): void;
+}
+
+/** A listening server: `close` stops listening and closes the current peer (no callback follows). */
+export interface TcpServerHandle {
+  close(): void;
+}
+
 export interface TcpBridge {
   connect(to: Endpoint, callbacks: TcpCallbacks, options?: TcpConnectOptions): TcpSocketHandle;
+  /** Listens at `at` (host "0.0.0.0" for every interface; port 0: any free one). */
+  listen?(at: Endpoint, callbacks: TcpListenCallbacks): TcpServerHandle;
 }
 
 export interface SerialOptions {
