@@ -19,3 +19,27 @@ describe("status: ticks a CatchUp: skip timer skipped", () => {
     expect(s.lateUntil).toBeCloseTo(now + 0.7, 12);
   });
 });
+
+describe("status: a device that delivers packets", () => {
+  // A Trigno base: 26 samples at 1925.926 Hz every 13.5 ms, each packet processed when it arrives.
+  const rate = 26 / 0.0135;
+  const packet = (k: number) =>
+    Frame.from(
+      vectorShape(1),
+      Array.from({ length: 26 }, (_, i) => (k * 26 + i) / rate),
+      Array.from({ length: 26 }, () => [0]),
+    );
+
+  test("reads on time between packets (10 periods are 5 ms), idle after 50 ms of silence", () => {
+    const s = new StatusTracker(rate);
+    let now = 0;
+    for (let k = 0; k < 40; k++) {
+      now = (k + 1) * 0.0135;
+      s.record(packet(k), now);
+      // Just before the next packet: 13 ms without output (was idle after 10 periods, 5.2 ms).
+      expect(s.evaluate(now + 0.013).status).toBe("ontime");
+    }
+    expect(s.evaluate(now + 0.049).status).toBe("ontime");
+    expect(s.evaluate(now + 0.051).status).toBe("idle");
+  });
+});

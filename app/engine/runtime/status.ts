@@ -1,8 +1,9 @@
 /**
  * Timing status as DESIGN.md §3 / the paper III-B, for a runtime that delivers events in batches:
  * - rate = (n − 1) / (t_last − t_first) over the last 100 outputs (event timestamps);
- * - idle (grey) when there was no output for 10 periods (plus the batching interval, during
- *   which a batch is allowed to wait), or none at all;
+ * - idle (grey) when there was no output for 10 periods and at least 50 ms (a gap between a
+ *   device's packets is not idleness), plus the batching interval (during which a batch is
+ *   allowed to wait), or none at all;
  * - lagging (red) when rate < 95 % of DesiredRate, or when an input batch reached the block
  *   late: its oldest event waited longer than max(2 periods, 50 ms) plus the batching interval
  *   (the engine is behind real time; lossless timers keep rates exact, so a rate alone would not
@@ -28,6 +29,17 @@ export const LAG_FRACTION = 0.95;
 export const IDLE_PERIODS = 10;
 /** Idle threshold for blocks without a desired rate (aperiodic, e.g. triggers). */
 export const APERIODIC_IDLE_S = 1;
+/**
+ * The shortest silence that reads idle, whatever the rate: devices deliver packets (a Trigno
+ * base 26 samples every 13.5 ms, a Myo two every 10 ms), and a gap between two packets is not
+ * idleness. 50 ms as LATE_MIN_S: one telemetry report at 20 Hz.
+ */
+export const IDLE_MIN_S = 0.05;
+
+/** How long without output reads idle for a block at `rate` Hz (≤ 0: aperiodic). */
+export function idleAfterS(rate: number, batchS: number): number {
+  return (rate > 0 ? Math.max(IDLE_PERIODS / rate, IDLE_MIN_S) : APERIODIC_IDLE_S) + batchS;
+}
 /** A batch is late when its oldest event waited longer than this many periods … */
 export const LATE_PERIODS = 2;
 /**
@@ -92,7 +104,7 @@ export class StatusTracker {
     const n = f.n;
     const rate = this.desiredRate;
     // Back from idle: the window restarts, so a pause does not read as lagging afterwards.
-    if (rate > 0 && now - this.lastWall > IDLE_PERIODS / rate + this.batchS) {
+    if (rate > 0 && now - this.lastWall > idleAfterS(rate, this.batchS)) {
       this.inWindow = 0;
       this.prevT = NaN;
     }
@@ -201,7 +213,7 @@ export class StatusTracker {
   evaluate(now: number): StatusEval {
     const rate = this.rate();
     const d = this.desiredRate;
-    const idleAfter = (d > 0 ? IDLE_PERIODS / d : APERIODIC_IDLE_S) + this.batchS;
+    const idleAfter = idleAfterS(d, this.batchS);
     if (this.events === 0 || now - this.lastWall > idleAfter) {
       return {
         status: "idle",

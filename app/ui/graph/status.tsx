@@ -17,7 +17,7 @@ export const STATUS_HELP: Record<Status, string> = {
   ontime: "on time: at least 95 % of its desired rate",
   lagging: "lagging: below 95 % of its desired rate",
   stumbling: "stumbling: one call took longer than a period",
-  idle: "idle: no output for 10 periods",
+  idle: "idle: no output for 10 periods (at least 50 ms)",
 };
 
 /** Short label of a block's status; "lagging, stumbling" when both hold. */
