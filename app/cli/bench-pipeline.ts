@@ -6,6 +6,7 @@
  */
 import { readFileSync } from "node:fs";
 import { join, relative } from "node:path";
+import { TrignoSimulator } from "../devices/trigno-simulator";
 import type { BlockTelemetry, Telemetry } from "../engine/runtime/runtime";
 import { runChild, type ChildRun, type CpuSample, type Summary } from "./bench-proc";
 import { clkTck } from "./bench-procfs";
@@ -71,11 +72,13 @@ export async function addWakeFloor(
   r: PipelineResult,
   o: { useNs: boolean; quick: boolean },
 ): Promise<void> {
-  const rate = r.timers[0]?.desiredRate;
+  const rate = def.wakeHz ?? r.timers[0]?.desiredRate;
   if (!o.useNs || rate === undefined || !(rate > 0) || def.neighbour) return;
-  const hz = wakeRate(rate, r.batchingMs);
+  const hz = def.wakeHz ?? wakeRate(rate, r.batchingMs);
   progress(
-    `${def.id}: wake-up floor, a bare worker sleeping at ${hz.toFixed(1)} Hz (${rate} Hz ticks, batching ${r.batchingMs} ms)`,
+    def.wakeHz !== undefined
+      ? `${def.id}: wake-up floor, a bare worker sleeping at ${hz.toFixed(1)} Hz (the device's packets)`
+      : `${def.id}: wake-up floor, a bare worker sleeping at ${hz.toFixed(1)} Hz (${rate} Hz ticks, batching ${r.batchingMs} ms)`,
   );
   r.wakeFloorHz = round(hz, 2);
   r.wakeFloorPct = round(await measureWakeFloor(hz, o.quick ? 3 : 10));
@@ -162,8 +165,10 @@ async function runBeside(
   res: PipelineResult,
 ): Promise<ChildRun> {
   const neighbour = def.neighbour ? startNeighbour() : undefined;
+  let simulator: { close(): Promise<void> } | undefined;
   try {
     if (neighbour) await sleep(200); // let it start spinning
+    if (def.simulator) simulator = await startSimulator(def.simulator);
     return await runChild({
       cli: o.cli,
       args,
@@ -175,8 +180,22 @@ async function runBeside(
   } finally {
     const burnt = neighbour?.stop();
     if (neighbour) res.neighbour = { command: neighbour.command, cpuPct: round(burnt ?? NaN, 1) };
+    await simulator?.close();
     await rx?.close();
   }
+}
+
+/** The device simulator of a workload, listening before the pipeline starts (16 paired sensors). */
+function startSimulator(
+  s: NonNullable<PipelineDef["simulator"]>,
+): Promise<{ close(): Promise<void> }> {
+  return TrignoSimulator.start({
+    host: "127.0.0.1",
+    commandPort: s.commandPort,
+    emgPort: s.emgPort,
+    auxPort: s.auxPort,
+    sensors: 16,
+  });
 }
 
 /** What every run reports, with a summary or without. */
@@ -213,11 +232,14 @@ function recordSummary(res: PipelineResult, run: ChildRun, s: Summary, useNs: bo
   res.batchingMs = scheduled[0]?.timer?.batchingMs ?? NaN;
   res.dropsAllTime = edgeDrops(s);
   res.drops = res.dropsAllTime - edgeDrops(run.baseline);
-  recordAcquisition(res, run, s, scheduled[0]?.desiredRate);
+  // The device's rate: a simulator's is its timer's, a device that paces itself (Delsys over TCP)
+  // has its own.
+  const device = s.blocks.find((b) => b.name === res.acquisition);
+  recordAcquisition(res, run, s, device?.desiredRate || scheduled[0]?.desiredRate);
 }
 
 /**
- * The acquisition chain: the blocks at the first ScheduledTimer's rate (Timer, the device, its
+ * The acquisition chain: the blocks at the acquisition block's rate (Timer, the device, its
  * filters); samples are lost when a tick is missed or an edge out of the chain drops.
  */
 function recordAcquisition(

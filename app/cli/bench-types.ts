@@ -262,12 +262,19 @@ export interface SoakResult {
     endMiB: number;
     maxMiB: number;
     minMiB: number;
-    /** Samples in each of the first and the last window (a minute, a tenth of a shorter run). */
+    /** Samples left out while memory settles (a third of the run, at most 600), and the growth
+     * over them: start → the median of the first window after, %. */
+    settleSamples: number;
+    settleGrowthPct: number;
+    /** Samples in each of the first and the last window after settling (a minute, a tenth of
+     * what is left of a shorter run). */
     windowSamples: number;
     firstMedianMiB: number;
     lastMedianMiB: number;
-    /** (last − first) / first of those medians, and (max − first) / first, %. */
+    /** (last − first) / first of those medians, and (max after settling − first) / first, %. */
     driftPct: number;
+    /** driftPct at the same slope over the whole run (what the tolerance judges), %. */
+    runDriftPct: number;
     maxOverStartPct: number;
     tolerancePct: number;
     flat: boolean;

@@ -18,6 +18,13 @@ export interface PipelineDef {
   udpRateHz?: number;
   /** Run while a neighbour process burns one core. */
   neighbour?: boolean;
+  /**
+   * A device simulator the bench runs in its own process for the run, on these ports (the
+   * pipeline's device block reads them); its CPU is not in the pipeline's figure.
+   */
+  simulator?: { device: "delsys"; commandPort: number; emgPort: number; auxPort: number };
+  /** The engine's wake-ups per second when the device's packets pace it (the wake-up floor's rate). */
+  wakeHz?: number;
 }
 export interface BatchingDef {
   kind: "batching";
@@ -102,6 +109,17 @@ export const WORKLOADS: WorkloadDef[] = [
     acquisition: "Delsys",
     udpRateHz: DELSYS_25,
     neighbour: true,
+  },
+  {
+    kind: "pipeline",
+    id: "delsys-tcp",
+    title:
+      "(b′) Delsys pipeline over TCP — the Trigno simulator's 8 sensors @ 1925.926 Hz, 26 samples every 13.5 ms",
+    file: "delsys-tcp.yaml",
+    acquisition: "Delsys",
+    udpRateHz: 25,
+    simulator: { device: "delsys", commandPort: 50540, emgPort: 50543, auxPort: 50544 },
+    wakeHz: 1 / 0.0135,
   },
   {
     kind: "pipeline",
