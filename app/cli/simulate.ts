@@ -13,6 +13,12 @@ import {
   pairedSensors,
 } from "../devices/trigno-simulator";
 import { dlrAdcBtSimulatorOptions, startDlrAdcBtSimulator } from "../devices/dlr-adcbt-simulator";
+import {
+  MuoviProbeSimulator,
+  muoviProbeSimulatorOptions,
+  SyncStationSimulator,
+  syncStationSimulatorOptions,
+} from "../devices/muovi-simulator";
 
 type OptionSpec = { type: "string" | "boolean"; default?: string | boolean };
 type Values = Record<string, string | boolean | undefined>;
@@ -127,6 +133,52 @@ export const SIMULATORS: Record<string, DeviceSimulator> = {
           `DLR ADC/BT simulator on ${sim.path}: waits for the channel count and start, then streams ` +
             `${sim.rate} frames/s (${sim.channels} channels until told otherwise), seed ${sim.seed}`,
           "Point DLR_ADCBT's Port at the other end of the pty pair. Ctrl-C stops it.",
+        ],
+        close: () => sim.close(),
+      };
+    },
+  },
+  syncstation: {
+    summary:
+      "OT Bioelettronica SyncStation (TCP server, 54320): after a start command streams its Muovi probes (38 int16 each) and its own 6 channels at 2000 Hz",
+    usage: "[--host ADDR] [--port P] [--seed S] [--verbose]",
+    options: {
+      host: { type: "string" },
+      port: { type: "string" },
+      seed: { type: "string" },
+      verbose: { type: "boolean", default: false },
+    },
+    async start(v, log) {
+      const sim = await SyncStationSimulator.start({
+        ...syncStationSimulatorOptions(v),
+        ...(v.verbose ? { log } : {}),
+      });
+      return {
+        lines: [
+          `SyncStation simulator listening on ${sim.host}:${sim.port}: waits for a start command (Muovi slots 0…3, CRC-8), then streams 38 channels per probe + 6 at 2000 Hz, seed ${sim.seed}`,
+          "Point Muovi's Host and Port there. Ctrl-C stops it.",
+        ],
+        close: () => sim.close(),
+      };
+    },
+  },
+  muovi: {
+    summary:
+      "OT Bioelettronica Muovi probe (TCP client): connects to a MuoviSingleProbe block's port, streams 38 int16 channels at 2000 Hz after the command byte, reconnects when dropped",
+    usage: "--connect HOST:PORT [--slot N] [--seed S] [--verbose]",
+    options: {
+      connect: { type: "string" },
+      slot: { type: "string" },
+      seed: { type: "string" },
+      verbose: { type: "boolean", default: false },
+    },
+    async start(v, log) {
+      const o = muoviProbeSimulatorOptions(v);
+      const sim = new MuoviProbeSimulator({ ...o, ...(v.verbose ? { log } : {}) });
+      return {
+        lines: [
+          `Muovi probe simulator connecting to ${o.host}:${o.port} (again every 0.5 s while not connected), seed ${sim.seed}`,
+          "Ctrl-C stops it.",
         ],
         close: () => sim.close(),
       };

@@ -361,12 +361,12 @@ describe("mosaic simulate delsys + mosaic run pipelines/devices/delsys.yaml", ()
     const none = runCli(["simulate"]);
     expect([none.code, none.stderr.trim()]).toEqual([
       2,
-      "usage: mosaic simulate DEVICE [options] (devices: delsys, dlr-adcbt)",
+      "usage: mosaic simulate DEVICE [options] (devices: delsys, dlr-adcbt, syncstation, muovi)",
     ]);
     const other = runCli(["simulate", "quattrocento"]);
     expect([other.code, other.stderr.trim()]).toEqual([
       2,
-      "mosaic simulate: no simulator for 'quattrocento' (devices: delsys, dlr-adcbt)",
+      "mosaic simulate: no simulator for 'quattrocento' (devices: delsys, dlr-adcbt, syncstation, muovi)",
     ]);
     const bad = runCli(["simulate", "delsys", "--sensors", "1,17"]);
     expect([bad.code, bad.stderr.trim()]).toEqual([

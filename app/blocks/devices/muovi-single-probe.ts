@@ -7,7 +7,8 @@ import {
   matrixShape,
 } from "../../engine";
 import { pacedDevice, pacingTimer } from "./paced-device";
-import { MUOVI_CHANNELS, MUOVI_PROBE_PORT, MUOVI_RATE, muoviProbeProtocol } from "./muovi-protocol";
+import { MUOVI_CHANNELS, MUOVI_PROBE_PORT, MUOVI_RATE } from "./muovi-protocol";
+import { muoviCountsText, muoviProbeProtocol, type MuoviProbeLink } from "./muovi-link";
 
 const params = z.strictObject({
   Probes: z
@@ -40,15 +41,23 @@ export const MuoviSingleProbe = defineBlock({
   summary:
     "EMG from one OT Bioelettronica Muovi probe over its own Wi-Fi: every raw sample since the last tick.",
   help:
-    "One Muovi probe connected directly (hold its button for 5 s and join the probe's Wi-Fi " +
-    "network; the probe connects to this computer's TCP port `Port`), as MOSAIC's " +
-    "MuoviSingleProbe: paced by one timer input, every tick emits the raw 2 kHz samples since the " +
-    "previous tick as a matrix [2000 / rate, 32 × probes] (rows = samples, oldest first; the " +
+    "One Muovi probe connected directly, as MOSAIC's MuoviSingleProbe: join the probe's Wi-Fi " +
+    "(hold its button for 5 s); this computer listens on TCP port `Port` (every interface), the " +
+    "probe connects to it and gets the start command byte (9: EMG mode, 32 monopolar channels, " +
+    "2 kHz), then streams 38 int16 big-endian channels per sample (protocol and sources in " +
+    "docs/protocols.md). Paced by one timer input: every tick emits the raw 2 kHz samples since " +
+    "the previous tick as a matrix [2000 / rate, 32 × probes] (rows = samples, oldest first; the " +
     "integer part of 2000 / rate, as the original), or a vector [1, 32 × probes] when the timer " +
-    "runs at 2 kHz, in mV. MOSAIC's positional form lists probe indices as Muovi's does " +
-    "(`Params: [0]`). The probe's protocol comes in a later release: until then the block says " +
-    "that the device is not reachable and sends zeros, and `mosaic run --simulate-devices` (or " +
-    "the app's Simulate devices switch) replaces it by simulated EMG of the same shape and rate.",
+    "runs at 2 kHz, in mV (raw × 0.000286, 286.1 nV per bit); it repeats the last when none came " +
+    "and sends zeros while not streaming. One probe streams here: it fills the first 32 columns " +
+    "and any further index in `Probes` (MOSAIC's positional form, `Params: [0]`) gives 32 columns " +
+    "of zeros. A probe that disconnects or is silent for 2 s is reported and the block waits for " +
+    "it to connect again (a new connection replaces a dead one); the stop byte (8) goes out when " +
+    "the pipeline stops. Malformed data is counted and skipped to the next whole sample (the " +
+    "probe's sample counter, its last channel, keeps the alignment). Never run against real " +
+    "hardware here: tested against `mosaic simulate muovi --connect HOST:PORT`. " +
+    "`mosaic run --simulate-devices` replaces it by simulated EMG of the same shape and rate. " +
+    "Unavailable in the browser build (no TCP).",
   params,
   legacyParams(args) {
     const items = args.filter((a) => a.trim() !== "");
@@ -65,7 +74,8 @@ export const MuoviSingleProbe = defineBlock({
   outputs: ["emg"],
   eventLoop: true,
   views: ["scope", "heatmap"],
-  panel: "Scope and heatmap of the channels; the link's state and samples received.",
+  panel:
+    "Scope and heatmap of the channels; the link's state, samples, samples the probe skipped, malformed data, reconnections.",
   create(ctx, p) {
     const rate = pacingTimer(ctx);
     const rows = muoviRows(rate);
@@ -74,12 +84,31 @@ export const MuoviSingleProbe = defineBlock({
         `the timer ticks at ${rate} Hz, faster than the probe samples (${MUOVI_RATE} Hz): pace it at ${MUOVI_RATE} Hz or slower`,
       );
     }
-    return pacedDevice(ctx, {
+    if (p.Probes.length > 1) {
+      ctx.warn(
+        `Muovi probe: one probe streams to this block; the ${p.Probes.length - 1} further index${p.Probes.length > 2 ? "es" : ""} in Probes give${p.Probes.length > 2 ? "" : "s"} columns of zeros`,
+      );
+    }
+    let link: MuoviProbeLink | undefined;
+    const instance = pacedDevice(ctx, {
       device: "Muovi probe",
       target: `a Muovi probe connecting to TCP port ${p.Port} of this computer (over the probe's Wi-Fi)`,
       shape: matrixShape(rows, MUOVI_CHANNELS * p.Probes.length),
       port: "emg",
-      protocol: muoviProbeProtocol(p, rows),
+      // Two of the probe's packets (18 samples each, as public readers take them) wait at most.
+      maxQueue: 2 * Math.ceil(18 / rows) + 1,
+      protocol: muoviProbeProtocol(p, rows, (l) => (link = l)),
     });
+    return {
+      ...instance,
+      actions: {
+        counts: {
+          label: "Counts",
+          description:
+            "Samples, samples the probe skipped, malformed and truncated data, reconnections",
+          run: () => muoviCountsText(link?.counts),
+        },
+      },
+    };
   },
 });

@@ -1,13 +1,20 @@
 import { z } from "zod";
-import { defineBlock, legacyInteger, LegacyParamsError, vectorShape } from "../../engine";
+import {
+  BlockConfigError,
+  defineBlock,
+  legacyInteger,
+  LegacyParamsError,
+  vectorShape,
+} from "../../engine";
 import { pacedDevice, pacingTimer } from "./paced-device";
 import {
   MUOVI_CHANNELS,
   MUOVI_HOST,
   MUOVI_PORT,
   MUOVI_RATE,
-  muoviProtocol,
+  SYNCSTATION_MUOVI_SLOTS,
 } from "./muovi-protocol";
+import { muoviCountsText, muoviProtocol, type SyncStationLink } from "./muovi-link";
 
 const params = z.strictObject({
   Probes: z
@@ -42,14 +49,22 @@ export const Muovi = defineBlock({
     "High-density EMG from OT Bioelettronica Muovi probes on a SyncStation: 32 channels per probe.",
   help:
     "OT Bioelettronica's Muovi probes (32 monopolar EMG channels each, 2 kHz) through a " +
-    "SyncStation, as MOSAIC's Muovi block: paced by one timer input, every tick emits one vector " +
-    "[1, 32 × probes] (the probes in the order of `Probes`, each probe's 32 channels in order), " +
-    "the average of the raw samples since the previous tick (2000 / rate of them), in the " +
-    "original's units (int16 / 32768). MOSAIC's positional form lists the probe indices: " +
-    "`Params: [0, 1]` is two probes, 64 channels. The SyncStation protocol (TCP to " +
-    `${MUOVI_HOST}:${MUOVI_PORT}) comes in a later release: until then the block says that the ` +
-    "device is not reachable and sends zeros, and `mosaic run --simulate-devices` (or the " +
-    "app's Simulate devices switch) replaces it by an EmgSimulator of the same shape and rate.",
+    "SyncStation, as MOSAIC's Muovi block: this computer connects to the SyncStation " +
+    `(TCP, ${MUOVI_HOST}:${MUOVI_PORT} on its Wi-Fi), sends the start command for the probes ` +
+    "in `Probes` (EMG mode, 32 monopolar channels; CRC-8 checked by the SyncStation) and parses " +
+    "its stream (int16 big-endian, 38 channels per probe in slot order, then the SyncStation's " +
+    "6; protocol and sources in docs/protocols.md). Paced by one timer input: every tick emits " +
+    "one vector [1, 32 × probes] (the probes in the order of `Probes`, each probe's 32 EMG " +
+    "channels in order), the average of 2000 / rate raw samples, in the original's units " +
+    "(int16 / 32768); it repeats the last when none came and sends zeros while not streaming. " +
+    "MOSAIC's positional form lists the probe indices: `Params: [0, 1]` is two probes, 64 " +
+    "channels; a SyncStation has Muovi slots 0…3. A refused or lost connection, or 2 s without " +
+    "data, is reported and retried (0.5 s doubling to 5 s); the stop command goes out when the " +
+    "pipeline stops. The stream is aligned by the SyncStation's sample counter (its last " +
+    "channel): malformed data is counted and skipped to the next whole sample, samples the " +
+    "SyncStation skipped are counted. Never run against real hardware here: tested against " +
+    "`mosaic simulate syncstation`. `mosaic run --simulate-devices` replaces it by an " +
+    "EmgSimulator of the same shape and rate. Unavailable in the browser build (no TCP).",
   params,
   legacyParams(args) {
     const items = args.filter((a) => a.trim() !== "");
@@ -66,15 +81,38 @@ export const Muovi = defineBlock({
   outputs: ["emg"],
   eventLoop: true,
   views: ["scope", "spider", "heatmap"],
-  panel: "Scope and heatmap of the channels; the link's state and samples received.",
+  panel:
+    "Scope and heatmap of the channels; the link's state, samples, samples skipped by the SyncStation, malformed data, reconnections.",
   create(ctx, p) {
     const rate = pacingTimer(ctx);
-    return pacedDevice(ctx, {
+    const bad = p.Probes.find((s) => s >= SYNCSTATION_MUOVI_SLOTS);
+    if (bad !== undefined) {
+      throw new BlockConfigError(
+        `probe index ${bad} is not a Muovi slot of the SyncStation (0…${SYNCSTATION_MUOVI_SLOTS - 1}; slots 4-5 are Muovi+/Sessantaquattro+, 6 and up Due+/Quattro+, which this block does not read)`,
+        "Probes",
+      );
+    }
+    let link: SyncStationLink | undefined;
+    const averageOver = Math.max(1, Math.floor(MUOVI_RATE / rate));
+    const instance = pacedDevice(ctx, {
       device: "Muovi",
       target: `the Muovi SyncStation at ${p.Host}:${p.Port} (TCP)`,
       shape: vectorShape(MUOVI_CHANNELS * p.Probes.length),
       port: "emg",
-      protocol: muoviProtocol(p, Math.max(1, Math.floor(MUOVI_RATE / rate))),
+      // Two of the SyncStation's packets (40 samples each, as public readers take them) wait at most.
+      maxQueue: 2 * Math.ceil(40 / averageOver) + 1,
+      protocol: muoviProtocol(p, averageOver, (l) => (link = l)),
     });
+    return {
+      ...instance,
+      actions: {
+        counts: {
+          label: "Counts",
+          description:
+            "Samples, samples the SyncStation skipped, malformed and truncated data, reconnections",
+          run: () => muoviCountsText(link?.counts),
+        },
+      },
+    };
   },
 });
