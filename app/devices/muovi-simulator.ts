@@ -90,7 +90,8 @@ function hash4(seed: number, a: number, b: number, c: number): number {
   return (h ^ (h >>> 16)) >>> 0;
 }
 
-const int16 = (x: number): number => Math.max(-32768, Math.min(32767, Math.round(x)));
+/** x rounded and clamped to int16 (| 0: never -0, which the wire cannot carry). */
+const int16 = (x: number): number => Math.max(-32768, Math.min(32767, Math.round(x))) | 0;
 
 /**
  * Channel `channel` (0…37) of the Muovi in `slot` (0…3) at sample k, as an int16: EMG-like on

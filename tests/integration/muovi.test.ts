@@ -62,14 +62,14 @@ async function freePort(): Promise<number> {
 async function harness(
   def: typeof Muovi | typeof MuoviSingleProbe,
   params: Record<string, unknown>,
-  timerRate: number,
+  timerRate: number | undefined,
   io = true,
 ) {
   const h = await BlockHarness.create(def, params, {
     ...(io ? { io: { tcp: nodeTcpBridge() } } : {}),
     now: wall(),
     virtual: false,
-    inputs: [{ shape: EMPTY_SHAPE, rate: timerRate, isTimer: true }],
+    ...(timerRate ? { inputs: [{ shape: EMPTY_SHAPE, rate: timerRate, isTimer: true }] } : {}),
   });
   const ticker = setInterval(() => {
     h.clock = wall();
@@ -244,6 +244,67 @@ describe("Muovi through a SyncStation", () => {
   });
 });
 
+describe("without an input: the device's 2000 Hz, as it delivers", () => {
+  /** Rows and stamps emitted so far. */
+  const emitted = (h: BlockHarness) => ({ v: h.output("emg").v, t: h.output("emg").t });
+
+  test("Muovi: every sample in order, raw / 32768, stamped 1 / 2000 s apart", async () => {
+    const sim = await syncStation(2);
+    const h = await harness(
+      Muovi,
+      { Probes: [1, 3], Host: "127.0.0.1", Port: sim.port },
+      undefined,
+    );
+    expect(h.desiredRate).toBe(2000);
+    h.start();
+    await until(() => emitted(h).v.length >= 200, "200 samples");
+    const { v, t } = emitted(h);
+    const k0 = findK(v[0]!, 2, 1, sim.samples);
+    expect(k0).toBeGreaterThanOrEqual(0);
+    for (let i = 0; i < 200; i++) {
+      const want = [
+        ...Array.from({ length: 32 }, (_, c) => muoviRaw(2, 1, c, k0 + i) / 32768),
+        ...Array.from({ length: 32 }, (_, c) => muoviRaw(2, 3, c, k0 + i) / 32768),
+      ];
+      const bad = want.flatMap((w, c) => (w === v[i]![c] ? [] : [`${c}: ${v[i]![c]} vs ${w}`]));
+      expect(bad, `sample ${i}`).toEqual([]);
+      if (i > 0) expect(t[i]! - t[i - 1]!).toBeCloseTo(1 / 2000, 6);
+    }
+    expect(h.text).toMatch(/^streaming 2 Muovi probes .* · [\d,]+ samples$/);
+  });
+
+  test("MuoviSingleProbe: every sample in order, in mV; a reconnection re-anchors the clock", async () => {
+    const port = await freePort();
+    const h = await harness(MuoviSingleProbe, { Probes: [0], Port: port }, undefined);
+    h.start();
+    await until(() => /^waiting/.test(h.text), "listening");
+    const p = new MuoviProbeSimulator({ host: "127.0.0.1", port, seed: 4, retry: 0.2 });
+    cleanup.push(() => p.close());
+    await until(() => emitted(h).v.length >= 100, "100 samples");
+    const { v, t } = emitted(h);
+    let k0 = -1;
+    for (let k = 0; k <= p.samples && k0 < 0; k++) {
+      if (
+        v[0]![0] === muoviRaw(4, 0, 0, k) * 0.000286 &&
+        v[0]![5] === muoviRaw(4, 0, 5, k) * 0.000286
+      )
+        k0 = k;
+    }
+    expect(k0).toBeGreaterThanOrEqual(0);
+    for (let i = 0; i < 100; i++) {
+      expect(v[i]).toEqual(
+        Array.from({ length: 32 }, (_, c) => muoviRaw(4, 0, c, k0 + i) * 0.000286),
+      );
+      if (i > 0) expect(t[i]! - t[i - 1]!).toBeCloseTo(1 / 2000, 6);
+    }
+    p.dropConnection();
+    await until(() => /^lost/.test(h.text), "lost");
+    const before = emitted(h).v.length;
+    await until(() => emitted(h).v.length > before + 50, "samples again");
+    expect(h.text).toMatch(/reconnected 1×/);
+  });
+});
+
 describe("MuoviSingleProbe (the probe connects to this computer)", () => {
   async function probe(port: number, seed = 9) {
     const p = new MuoviProbeSimulator({ host: "127.0.0.1", port, seed, retry: 0.2 });
@@ -371,7 +432,7 @@ describe("mosaic simulate syncstation|muovi + mosaic run", () => {
     expect(r.code, r.stderr).toBe(0);
     const out = jsonLines(r.stdout);
     const summary = out.find((l) => l.type === "summary") as
-      { blocks: { name: string; events: number }[] } | undefined;
+      { blocks: { name: string; events: number; text: string }[] } | undefined;
     expect(summary, r.stdout.slice(-2000)).toBeDefined();
     const warnings = out.filter((l) => l.type === "event" && l.level === "warning");
     expect(warnings.filter((w) => /not reachable|malformed/.test(String(w.message)))).toEqual([]);
@@ -442,6 +503,21 @@ describe("mosaic simulate syncstation|muovi + mosaic run", () => {
     expect(r.code, r.stderr).toBe(0);
     expect(r.stderr + r.stdout).toMatch(
       /block 'Probes' \(Muovi\) simulated by EmgSimulator, 64 channels at 2000 Hz/,
+    );
+    // The native forms (no timer) become EmgSimulators on a new 2000 Hz timer.
+    const dir = tempDir("mosaic-muovi-native-");
+    const file = join(dir, "native.yaml");
+    writeFileSync(
+      file,
+      "Probes: { Type: Muovi, Params: { Probes: [0, 1] } }\nProbe: { Type: MuoviSingleProbe }\n",
+    );
+    const v = runCli(["validate", "--simulate-devices", file]);
+    expect(v.code, v.stderr).toBe(0);
+    expect(v.stdout + v.stderr).toMatch(
+      /block 'Probes' \(Muovi\) simulated by EmgSimulator, 64 channels at 2000 Hz \(a new ScheduledTimer/,
+    );
+    expect(v.stdout + v.stderr).toMatch(
+      /block 'Probe' \(MuoviSingleProbe\) simulated by EmgSimulator, 32 channels at 2000 Hz \(a new ScheduledTimer/,
     );
     const bad = runCli(["simulate", "muovi"]);
     expect([bad.code, bad.stderr.trim()]).toEqual([

@@ -15,7 +15,16 @@
  * samples the device skipped (its counter jumped), malformed data (bytes skipped to realign),
  * connections that ended inside a sample, reconnections.
  */
-import type { BlockContext, TcpBridge, TcpServerHandle, TcpSocketHandle } from "../../engine";
+import {
+  vectorShape,
+  type BlockContext,
+  type BlockInstance,
+  type TcpBridge,
+  type TcpServerHandle,
+  type TcpSocketHandle,
+} from "../../engine";
+import { plural, TextThrottle } from "../shared/text";
+import { DeviceClock } from "./delsys-protocol";
 import type { DeviceProtocol, DeviceSampleSink } from "./paced-device";
 import {
   MUOVI_CHANNELS,
@@ -48,6 +57,8 @@ export interface MuoviLinkEvents {
   samples(raw: Int16Array): void;
   state(phase: MuoviPhase, text: string): void;
   warn(message: string): void;
+  /** The samples of one TCP chunk have all been given (the native form emits them as a frame). */
+  chunkEnd?(): void;
 }
 
 export interface MuoviCounts {
@@ -155,6 +166,7 @@ abstract class MuoviLinkBase {
     else if (this.streaming && this.extras() !== this.shownExtras) {
       this.ev.state("streaming", this.statusText());
     }
+    this.ev.chunkEnd?.();
   }
 
   private shownExtras = "";
@@ -547,4 +559,107 @@ export function muoviCountsText(c: MuoviCounts | undefined): string {
     `${c.malformed} malformed (${c.skippedBytes} bytes skipped${c.lastProblem ? `, last: ${c.lastProblem}` : ""}), ` +
     `${c.truncated} truncated (${c.truncatedBytes} bytes)`
   );
+}
+
+export interface NativeMuoviOptions {
+  /** Output channels (vector [1, channels] per sample). */
+  channels: number;
+  /** "the SyncStation at …", for the no-TCP message. */
+  target: string;
+  /** Whether this host can reach the device (a TCP bridge, with listen when needed). */
+  available(ctx: BlockContext): boolean;
+  /** Opens the link with these events (the bridge is available). */
+  open(ctx: BlockContext, ev: MuoviLinkEvents): { close(): void };
+  /** Writes one sample's output values from its raw values at `out[at…]`. */
+  convert(raw: Int16Array, out: Float64Array, at: number): void;
+}
+
+/**
+ * The blocks without an input: their own source at the device's 2000 Hz. The samples of each TCP
+ * chunk go out at once as one frame, stamped on the device's sample clock (the first batch's last
+ * sample at its arrival, then 1 / 2000 s apart, at most one SyncStation packet, 20 ms, ahead of
+ * arrival; re-anchored after a loss, the gap counted).
+ */
+export function nativeMuoviSource(ctx: BlockContext, o: NativeMuoviOptions): BlockInstance {
+  if (ctx.declaredRate === undefined) ctx.setDesiredRate(MUOVI_RATE);
+  const k = o.channels;
+  const out = ctx.output(vectorShape(k), "emg");
+  const clock = new DeviceClock(MUOVI_RATE, 0.5, 40 / MUOVI_RATE);
+  const throttle = new TextThrottle(0.5);
+  let batch = new Float64Array(64 * k);
+  let n = 0;
+  let emitted = 0;
+  let phase = "stopped";
+  let lastText = "";
+  let link: { close(): void } | undefined;
+
+  const refresh = (): void => {
+    let text = phase;
+    if (emitted > 0) text += ` · ${plural(emitted, "sample")}`;
+    if (clock.gapSamples > 0) text += ` · ${clock.gapSamples} samples lost in gaps`;
+    if (text !== lastText) {
+      lastText = text;
+      ctx.setText(text);
+    }
+  };
+
+  const events: MuoviLinkEvents = {
+    samples(raw) {
+      if ((n + 1) * k > batch.length) {
+        const bigger = new Float64Array(batch.length * 2);
+        bigger.set(batch);
+        batch = bigger;
+      }
+      o.convert(raw, batch, n * k);
+      n++;
+    },
+    chunkEnd() {
+      if (n === 0) return;
+      const f = out.frame(n);
+      clock.stamp(ctx.now(), f.t, n);
+      f.v.set(batch.subarray(0, n * k));
+      out.emit(f);
+      emitted += n;
+      n = 0;
+      if (throttle.due(ctx.now())) refresh();
+    },
+    state(p, text) {
+      if (p !== "streaming") {
+        clock.restart();
+        n = 0;
+      }
+      phase = text;
+      refresh();
+    },
+    warn: (m) => ctx.warn(m),
+  };
+
+  refresh();
+  return {
+    start() {
+      if (!o.available(ctx)) {
+        phase = "TCP not available in the browser build; use --simulate-devices";
+        refresh();
+        ctx.warn(noTcpMessage(o.target));
+        return;
+      }
+      link = o.open(ctx, events);
+    },
+    stop() {
+      link?.close();
+      link = undefined;
+      phase = "stopped";
+      refresh();
+    },
+    reset() {
+      clock.reset();
+      emitted = 0;
+      throttle.reset();
+      refresh();
+    },
+    dispose() {
+      link?.close();
+      link = undefined;
+    },
+  };
 }

@@ -8,7 +8,13 @@ import {
 } from "../../engine";
 import { pacedDevice, pacingTimer } from "./paced-device";
 import { MUOVI_CHANNELS, MUOVI_PROBE_PORT, MUOVI_RATE } from "./muovi-protocol";
-import { muoviCountsText, muoviProbeProtocol, type MuoviProbeLink } from "./muovi-link";
+import {
+  muoviCountsText,
+  muoviProbeProtocol,
+  MuoviProbeLink,
+  nativeMuoviSource,
+} from "./muovi-link";
+import { MUOVI_MV_PER_BIT } from "./muovi-protocol";
 
 const params = z.strictObject({
   Probes: z
@@ -45,7 +51,10 @@ export const MuoviSingleProbe = defineBlock({
     "(hold its button for 5 s); this computer listens on TCP port `Port` (every interface), the " +
     "probe connects to it and gets the start command byte (9: EMG mode, 32 monopolar channels, " +
     "2 kHz), then streams 38 int16 big-endian channels per sample (protocol and sources in " +
-    "docs/protocols.md). Paced by one timer input: every tick emits the raw 2 kHz samples since " +
+    "docs/protocols.md). **Without an input** it is its own source at 2000 Hz: each TCP chunk's " +
+    "samples go out at once as one frame of vectors [1, 32 × probes] in mV, stamped on the " +
+    "probe's sample clock. **With a timer input** (MOSAIC's form): every tick emits the raw 2 kHz " +
+    "samples since " +
     "the previous tick as a matrix [2000 / rate, 32 × probes] (rows = samples, oldest first; the " +
     "integer part of 2000 / rate, as the original), or a vector [1, 32 × probes] when the timer " +
     "runs at 2 kHz, in mV (raw × 0.000286, 286.1 nV per bit); it repeats the last when none came " +
@@ -70,13 +79,45 @@ export const MuoviSingleProbe = defineBlock({
     return { Probes: items.map((a, i) => legacyInteger(a, `probe index ${i + 1}`, "Probes")) };
   },
   legacyForm: "[probeIndex, …] (0-based), e.g. [0]",
-  inputs: { min: 1, max: 1, labels: ["timer"] },
+  inputs: { min: 0, max: 1, labels: ["timer"] },
   outputs: ["emg"],
   eventLoop: true,
   views: ["scope", "heatmap"],
   panel:
     "Scope and heatmap of the channels; the link's state, samples, samples the probe skipped, malformed data, reconnections.",
   create(ctx, p) {
+    let link: MuoviProbeLink | undefined;
+    const actions = {
+      counts: {
+        label: "Counts",
+        description:
+          "Samples, samples the probe skipped, malformed and truncated data, reconnections",
+        run: () => muoviCountsText(link?.counts),
+      },
+    };
+    if (p.Probes.length > 1) {
+      ctx.warn(
+        `Muovi probe: one probe streams to this block; the ${p.Probes.length - 1} further index${p.Probes.length > 2 ? "es" : ""} in Probes give${p.Probes.length > 2 ? "" : "s"} columns of zeros`,
+      );
+    }
+    if (ctx.inputs.length === 0) {
+      const cols = MUOVI_CHANNELS * p.Probes.length;
+      const instance = nativeMuoviSource(ctx, {
+        channels: cols,
+        target: `a Muovi probe on TCP port ${p.Port}`,
+        available: (c) => c.io.tcp?.listen !== undefined,
+        open(c, ev) {
+          link = new MuoviProbeLink(c, c.io.tcp!, { host: "0.0.0.0", port: p.Port }, ev);
+          link.open();
+          return link;
+        },
+        convert(raw, out, at) {
+          for (let j = 0; j < MUOVI_CHANNELS; j++) out[at + j] = raw[j]! * MUOVI_MV_PER_BIT;
+          out.fill(0, at + MUOVI_CHANNELS, at + cols);
+        },
+      });
+      return { ...instance, actions };
+    }
     const rate = pacingTimer(ctx);
     const rows = muoviRows(rate);
     if (rows < 1) {
@@ -84,12 +125,6 @@ export const MuoviSingleProbe = defineBlock({
         `the timer ticks at ${rate} Hz, faster than the probe samples (${MUOVI_RATE} Hz): pace it at ${MUOVI_RATE} Hz or slower`,
       );
     }
-    if (p.Probes.length > 1) {
-      ctx.warn(
-        `Muovi probe: one probe streams to this block; the ${p.Probes.length - 1} further index${p.Probes.length > 2 ? "es" : ""} in Probes give${p.Probes.length > 2 ? "" : "s"} columns of zeros`,
-      );
-    }
-    let link: MuoviProbeLink | undefined;
     const instance = pacedDevice(ctx, {
       device: "Muovi probe",
       target: `a Muovi probe connecting to TCP port ${p.Port} of this computer (over the probe's Wi-Fi)`,
@@ -99,16 +134,6 @@ export const MuoviSingleProbe = defineBlock({
       maxQueue: 2 * Math.ceil(18 / rows) + 1,
       protocol: muoviProbeProtocol(p, rows, (l) => (link = l)),
     });
-    return {
-      ...instance,
-      actions: {
-        counts: {
-          label: "Counts",
-          description:
-            "Samples, samples the probe skipped, malformed and truncated data, reconnections",
-          run: () => muoviCountsText(link?.counts),
-        },
-      },
-    };
+    return { ...instance, actions };
   },
 });

@@ -14,7 +14,8 @@ import {
   MUOVI_RATE,
   SYNCSTATION_MUOVI_SLOTS,
 } from "./muovi-protocol";
-import { muoviCountsText, muoviProtocol, type SyncStationLink } from "./muovi-link";
+import { muoviCountsText, muoviProtocol, nativeMuoviSource, SyncStationLink } from "./muovi-link";
+import { MUOVI_FULL_SCALE, slotOffsets } from "./muovi-protocol";
 
 const params = z.strictObject({
   Probes: z
@@ -53,7 +54,10 @@ export const Muovi = defineBlock({
     `(TCP, ${MUOVI_HOST}:${MUOVI_PORT} on its Wi-Fi), sends the start command for the probes ` +
     "in `Probes` (EMG mode, 32 monopolar channels; CRC-8 checked by the SyncStation) and parses " +
     "its stream (int16 big-endian, 38 channels per probe in slot order, then the SyncStation's " +
-    "6; protocol and sources in docs/protocols.md). Paced by one timer input: every tick emits " +
+    "6; protocol and sources in docs/protocols.md). **Without an input** it is its own source at " +
+    "the probes' 2000 Hz: each TCP chunk's samples go out at once as one frame of vectors " +
+    "[1, 32 × probes] (raw / 32768), stamped on the device's sample clock. **With a timer input** " +
+    "(MOSAIC's form): every tick emits " +
     "one vector [1, 32 × probes] (the probes in the order of `Probes`, each probe's 32 EMG " +
     "channels in order), the average of 2000 / rate raw samples, in the original's units " +
     "(int16 / 32768); it repeats the last when none came and sends zeros while not streaming. " +
@@ -77,14 +81,13 @@ export const Muovi = defineBlock({
     return { Probes: items.map((a, i) => legacyInteger(a, `probe index ${i + 1}`, "Probes")) };
   },
   legacyForm: "[probeIndex, …] (0-based), e.g. [0, 1] for two probes (64 channels)",
-  inputs: { min: 1, max: 1, labels: ["timer"] },
+  inputs: { min: 0, max: 1, labels: ["timer"] },
   outputs: ["emg"],
   eventLoop: true,
   views: ["scope", "spider", "heatmap"],
   panel:
     "Scope and heatmap of the channels; the link's state, samples, samples skipped by the SyncStation, malformed data, reconnections.",
   create(ctx, p) {
-    const rate = pacingTimer(ctx);
     const bad = p.Probes.find((s) => s >= SYNCSTATION_MUOVI_SLOTS);
     if (bad !== undefined) {
       throw new BlockConfigError(
@@ -93,6 +96,38 @@ export const Muovi = defineBlock({
       );
     }
     let link: SyncStationLink | undefined;
+    const actions = {
+      counts: {
+        label: "Counts",
+        description:
+          "Samples, samples the SyncStation skipped, malformed and truncated data, reconnections",
+        run: () => muoviCountsText(link?.counts),
+      },
+    };
+    if (ctx.inputs.length === 0) {
+      const offsets = slotOffsets(p.Probes);
+      const o = { host: p.Host, port: p.Port, slots: p.Probes };
+      const instance = nativeMuoviSource(ctx, {
+        channels: MUOVI_CHANNELS * offsets.length,
+        target: `the SyncStation at ${p.Host}:${p.Port}`,
+        available: (c) => c.io.tcp !== undefined,
+        open(c, ev) {
+          link = new SyncStationLink(c, c.io.tcp!, o, ev);
+          link.open();
+          return link;
+        },
+        convert(raw, out, at) {
+          for (let i = 0; i < offsets.length; i++) {
+            const off = offsets[i]!;
+            for (let j = 0; j < MUOVI_CHANNELS; j++) {
+              out[at + i * MUOVI_CHANNELS + j] = raw[off + j]! / MUOVI_FULL_SCALE;
+            }
+          }
+        },
+      });
+      return { ...instance, actions };
+    }
+    const rate = pacingTimer(ctx);
     const averageOver = Math.max(1, Math.floor(MUOVI_RATE / rate));
     const instance = pacedDevice(ctx, {
       device: "Muovi",
@@ -103,16 +138,6 @@ export const Muovi = defineBlock({
       maxQueue: 2 * Math.ceil(40 / averageOver) + 1,
       protocol: muoviProtocol(p, averageOver, (l) => (link = l)),
     });
-    return {
-      ...instance,
-      actions: {
-        counts: {
-          label: "Counts",
-          description:
-            "Samples, samples the SyncStation skipped, malformed and truncated data, reconnections",
-          run: () => muoviCountsText(link?.counts),
-        },
-      },
-    };
+    return { ...instance, actions };
   },
 });

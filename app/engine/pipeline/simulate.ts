@@ -89,6 +89,24 @@ const hz = (r: number | undefined): string =>
 /** The device's timer input (its first input), as written. */
 const timerOf = (b: BlockSpec): InputRef | undefined => b.inputs[0];
 
+/** An EmgSimulator on a new ScheduledTimer at `rate`, for an EMG device without a timer input. */
+function emgAtRate(b: BlockSpec, env: SimulationEnv, channels: number, rate: number): Replacement {
+  const clock = env.freshName(`${b.name}_clock`);
+  return {
+    blocks: [
+      { name: clock, type: "ScheduledTimer", params: {}, inputs: [], desiredRate: rate },
+      {
+        name: b.name,
+        type: "EmgSimulator",
+        params: { Channels: channels, Seed: seedOf(b.name) },
+        inputs: [clock],
+      },
+    ],
+    ports: { [b.outputs[0]!]: { block: b.name, port: "emg" } },
+    summary: `EmgSimulator, ${channels} channels at ${hz(rate)} (a new ScheduledTimer at the device's rate); gesture keys in the app`,
+  };
+}
+
 /** An EmgSimulator in place of an EMG device paced by its timer input. */
 function emgOnTimer(
   b: BlockSpec,
@@ -201,17 +219,22 @@ export const SIMULATED_DEVICES: Readonly<Record<string, DeviceRule>> = {
   Muovi: {
     kind: "source",
     network: false,
-    becomes: "EmgSimulator with 32 × probes channels on its timer",
-    substitute: (b, env) => emgOnTimer(b, env, 32 * (p(b).Probes as number[]).length),
+    becomes:
+      "EmgSimulator with 32 × probes channels on its timer (without one, a new ScheduledTimer at the probes' 2000 Hz)",
+    substitute: (b, env) => {
+      const channels = 32 * (p(b).Probes as number[]).length;
+      return timerOf(b) ? emgOnTimer(b, env, channels) : emgAtRate(b, env, channels, 2000);
+    },
   },
   MuoviSingleProbe: {
     kind: "source",
     network: false,
     becomes:
-      "EmgSimulator with 32 × probes channels; below 2 kHz, at 2 kHz (a new ScheduledTimer) framed by a SlidingWindow into the same [2000 / rate, channels] matrices",
+      "EmgSimulator with 32 × probes channels; below 2 kHz, at 2 kHz (a new ScheduledTimer) framed by a SlidingWindow into the same [2000 / rate, channels] matrices (without a timer, at 2 kHz)",
     substitute(b, env) {
       const channels = 32 * (p(b).Probes as number[]).length;
-      const timer = timerOf(b)!;
+      const timer = timerOf(b);
+      if (!timer) return emgAtRate(b, env, channels, 2000);
       const rate = env.rateOf(timer.block);
       const rows = rate !== undefined ? Math.floor(2000 / rate) : 1;
       if (rows <= 1) return emgOnTimer(b, env, channels);
