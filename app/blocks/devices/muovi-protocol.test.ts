@@ -134,6 +134,43 @@ describe("MuoviStreamParser", () => {
     expect(p.held).toBe(0);
   });
 
+  test("seeded fuzz: junk of 1–60 bytes at random sample boundaries, random chunks: every sample, junk counted exactly", () => {
+    let seed = 12345;
+    const rnd = (n: number): number => {
+      seed = (Math.imul(seed, 1103515245) + 12345) >>> 0;
+      return (seed >>> 8) % n;
+    };
+    for (let round = 0; round < 40; round++) {
+      const ch = 38 + 6 * rnd(3);
+      const parts: Uint8Array[] = [];
+      let junkBytes = 0;
+      let junks = 0;
+      for (let k = 0; k < 300; k += 10) {
+        parts.push(stream(k, 10, ch));
+        if (k + 10 < 300 && rnd(3) === 0) {
+          const junk = Uint8Array.from({ length: 1 + rnd(60) }, () => rnd(256));
+          parts.push(junk);
+          junkBytes += junk.length;
+          junks++;
+        }
+      }
+      const all = new Uint8Array(parts.reduce((a, p) => a + p.length, 0));
+      parts.reduce((at, p) => (all.set(p, at), at + p.length), 0);
+      const { p, got } = collect(ch);
+      for (let at = 0; at < all.length;) {
+        const n = 1 + rnd(300);
+        p.feed(all.subarray(at, at + n));
+        at += n;
+      }
+      expect(got, `round ${round}`).toEqual(Array.from({ length: 300 }, (_, i) => i));
+      expect([p.malformed, p.skippedBytes, p.lostSamples], `round ${round}`).toEqual([
+        junks,
+        junkBytes,
+        0,
+      ]);
+    }
+  });
+
   test("bytes that never count (no Muovi there) are skipped and counted, nothing emitted", () => {
     const { p, got } = collect(38);
     const junk = Uint8Array.from({ length: 5000 }, (_, i) => (i * 7919) & 255);
