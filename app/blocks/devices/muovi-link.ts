@@ -65,6 +65,8 @@ export interface MuoviCounts {
   samples: number;
   /** Samples the device skipped (its counter jumped ahead). */
   lostSamples: number;
+  /** Times the counter restarted (or jumped too far to count the samples in between). */
+  counterJumps: number;
   malformed: number;
   skippedBytes: number;
   lastProblem: string;
@@ -87,6 +89,7 @@ abstract class MuoviLinkBase {
   readonly counts: MuoviCounts = {
     samples: 0,
     lostSamples: 0,
+    counterJumps: 0,
     malformed: 0,
     skippedBytes: 0,
     lastProblem: "",
@@ -154,6 +157,7 @@ abstract class MuoviLinkBase {
     const c = this.counts;
     c.samples = p.samples;
     c.lostSamples = p.lostSamples;
+    c.counterJumps = p.counterJumps;
     c.malformed = p.malformed;
     c.skippedBytes = p.skippedBytes;
     c.lastProblem = p.lastProblem;
@@ -555,7 +559,7 @@ export function muoviProbeProtocol(
 export function muoviCountsText(c: MuoviCounts | undefined): string {
   if (!c) return "not started";
   return (
-    `${c.samples} samples, ${c.lostSamples} skipped by the device, ${c.reconnections} reconnections, ` +
+    `${c.samples} samples, ${c.lostSamples} skipped by the device, ${c.counterJumps} counter restarts, ${c.reconnections} reconnections, ` +
     `${c.malformed} malformed (${c.skippedBytes} bytes skipped${c.lastProblem ? `, last: ${c.lastProblem}` : ""}), ` +
     `${c.truncated} truncated (${c.truncatedBytes} bytes)`
   );

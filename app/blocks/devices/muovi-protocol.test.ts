@@ -121,6 +121,15 @@ describe("MuoviStreamParser", () => {
     expect([p.lostSamples, p.malformed, p.skippedBytes]).toEqual([100, 0, 0]);
   });
 
+  test("a counter that restarts (back, or further than 2000 ahead) and counts on is a restart, not misalignment", () => {
+    const { p, got } = collect(44);
+    p.feed(stream(0, 5, 44));
+    p.feed(stream(0, 5, 44));
+    p.feed(stream(30000, 5, 44));
+    expect(got).toEqual([0, 1, 2, 3, 4, 0, 1, 2, 3, 4, 30000, 30001, 30002, 30003, 30004]);
+    expect([p.counterJumps, p.lostSamples, p.malformed, p.skippedBytes]).toEqual([2, 0, 0, 0]);
+  });
+
   test("a stream starting inside a sample locks onto the first whole one; reset returns what was held", () => {
     const { p, got } = collect(44);
     const s = stream(7, 10, 44);

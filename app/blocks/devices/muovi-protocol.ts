@@ -99,7 +99,8 @@ export const MAX_GAP = 2000;
  * Splits an int16 big-endian stream of `channels` values per sample into samples, aligned by the
  * last channel (a counter, +1 per sample). `onSample(raw)` gets each sample's values (reused:
  * copy what you keep). A counter that jumps ahead and goes on counting from there is a gap
- * (`lostSamples`); one that does not is misalignment: counted (`malformed`, once per episode),
+ * (`lostSamples`; a jump back or beyond MAX_GAP that counts on for LOCK_SAMPLES is a restart,
+ * `counterJumps`); one that does not is misalignment: counted (`malformed`, once per episode),
  * bytes skipped (`skippedBytes`) until `LOCK_SAMPLES` samples in a row count again.
  */
 export class MuoviStreamParser {
@@ -111,6 +112,8 @@ export class MuoviStreamParser {
   private readonly raw: Int16Array;
   samples = 0;
   lostSamples = 0;
+  /** Times the counter restarted or jumped by more than MAX_GAP and counted on from there. */
+  counterJumps = 0;
   malformed = 0;
   skippedBytes = 0;
   lastProblem = "";
@@ -214,6 +217,11 @@ export class MuoviStreamParser {
         const gap = (c - this.expected) & 0xffff;
         if (gap <= MAX_GAP && this.counter(at + S) === ((c + 1) & 0xffff)) {
           this.lostSamples += gap;
+        } else if (this.len - at < LOCK_SAMPLES * S) {
+          break; // a restarted counter or misalignment: the next samples say which
+        } else if (this.findLock(at) === at) {
+          // The counter restarted (or jumped further than a gap) and counts on, aligned.
+          this.counterJumps++;
         } else {
           this.misaligned(
             `sample counter ${c} where ${this.expected} was due and no count follows: misaligned`,
