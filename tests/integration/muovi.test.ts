@@ -129,7 +129,9 @@ describe("Muovi through a SyncStation", () => {
         ],
       },
     ]);
-    await sleep(40);
+    // Enough samples queued for 60 ticks (the newest 81 wait), however loaded the machine.
+    await until(() => sim.samples >= 120, "120 samples sent");
+    await sleep(20);
     const rows = ticks(h, 60);
     expect(rows).toHaveLength(60);
     const k0 = findK(rows[0]!, 7, 2, sim.samples);
@@ -151,7 +153,8 @@ describe("Muovi through a SyncStation", () => {
     const h = await harness(Muovi, { Probes: [1], Host: "127.0.0.1", Port: sim.port }, 200);
     h.start();
     await until(() => /^streaming 1 Muovi probe /.test(h.text), "streaming");
-    await sleep(60);
+    await until(() => sim.samples >= 100, "100 samples sent");
+    await sleep(20);
     const rows = ticks(h, 5);
     const mean = (k: number, c: number): number => {
       let acc = 0;
@@ -329,7 +332,8 @@ describe("MuoviSingleProbe (the probe connects to this computer)", () => {
       "streaming",
     );
     expect(p.received).toEqual([9]);
-    await sleep(40);
+    await until(() => p.samples >= 60, "60 samples sent");
+    await sleep(20);
     const mats = ticks(h, 3);
     expect(mats).toHaveLength(3);
     expect(mats[0]).toHaveLength(10 * 32);
