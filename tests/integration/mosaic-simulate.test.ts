@@ -129,7 +129,9 @@ describe("without --simulate-devices", () => {
       expect(String(w.message)).toMatch(
         w.block === "trigno" // Delsys speaks its protocol: nothing listens at the TCU's port here
           ? /Trigno Control Utility at 127\.0\.0\.1:50040 not reachable: .* --simulate-devices/
-          : /not reachable: this version cannot talk to .* --simulate-devices/,
+          : w.block === "forces" // DLR_ADCBT speaks its protocol: there is no COM7 here
+            ? /DLR ADC\/BT: cannot open COM7: .* --simulate-devices/
+            : /not reachable: this version cannot talk to .* --simulate-devices/,
       );
     }
     const summary = jsonLines(r.stdout).find((l) => l.type === "summary") as {

@@ -37,6 +37,10 @@ function reconnecting(message: string): string {
   return message.replace(/; retrying every (.+)$/, " — reconnecting every $1");
 }
 
+/** What to do without the board, said with the first failure to open its port. */
+const DLR_WITHOUT_BOARD =
+  "without the board: mosaic run --simulate-devices, or a simulated board: mosaic simulate dlr-adcbt --port PATH";
+
 /** The protocol module for `DLR_ADCBT` (see the file comment). */
 export function dlrAdcBtProtocol(link: {
   Port?: string | undefined;
@@ -126,7 +130,9 @@ class DlrLink {
         this.phase = wasOpen ? "lost" : "failing";
         this.detail = message;
         this.warnOnce(
-          wasOpen ? `lost ${this.path}: ${message}` : `cannot open ${this.path}: ${message}`,
+          wasOpen
+            ? `lost ${this.path}: ${message}`
+            : `cannot open ${this.path}: ${message} (${DLR_WITHOUT_BOARD})`,
         );
         this.describe();
         return;
