@@ -233,8 +233,10 @@ Emg: { Type: EmgSimulator, Inputs: [Timer], Params: { Channels: 1 } }
       .at(-1)!
       .blocks.find((b) => b.name === "Py")!;
     expect(last.text).toMatch(/errors \(last: ValueError: every third call fails/);
-    // hold: an output for every input, failed ones included, so the block stays on time.
-    expect(last.status).toBe("ontime");
+    // hold: an output for every input, failed ones included, so the block keeps its rate: on
+    // time, or stumbling when a call ran past its budget on a loaded machine — never lagging.
+    expect(["ontime", "stumbling"], last.text).toContain(last.status);
+    expect(last.rate).toBeGreaterThan(0.95 * 50);
   }, 120_000);
 
   test("a syntax error in the module is a load error with the block, file and line", () => {
