@@ -1,7 +1,7 @@
 import { readFileSync } from "node:fs";
 import { join } from "node:path";
 import { beforeAll, describe, expect, test } from "vitest";
-import { jsonLines, requireBuild, ROOT, runCli, tempDir } from "./helpers";
+import { jsonLines, KEEPING_UP, requireBuild, ROOT, runCli, tempDir } from "./helpers";
 
 beforeAll(requireBuild);
 
@@ -76,13 +76,15 @@ describe("fatigue replay: windows, artifact rejection, features", () => {
       .at(-1) as unknown as {
       blocks: { name: string; status: string; rate: number }[];
     };
-    expect(tel.blocks.map((b) => [b.name, b.status])).toEqual([
-      ["Recording", "ontime"],
-      ["Windows", "ontime"],
-      ["Clean", "ontime"],
-      ["Features", "ontime"],
-      ["Rejected", "ontime"],
+    // Every block keeps up (a catch-up call on a loaded machine may make one stumble, never lag).
+    expect(tel.blocks.map((b) => b.name)).toEqual([
+      "Recording",
+      "Windows",
+      "Clean",
+      "Features",
+      "Rejected",
     ]);
+    for (const b of tel.blocks) expect(KEEPING_UP, b.name).toContain(b.status);
     const lines = readFileSync(join(dir, "fatigue-features/Features.txt"), "utf8")
       .trim()
       .split("\n");

@@ -47,3 +47,11 @@ export function jsonLines(stdout: string): Record<string, unknown>[] {
     .filter((l) => l.startsWith("{"))
     .map((l) => JSON.parse(l) as Record<string, unknown>);
 }
+
+/**
+ * A block that keeps up in real time: on time, or stumbling when one call (a catch-up frame after
+ * the OS preempted the worker on a loaded CI machine) took longer than its events cover — never
+ * lagging, never idle. Use for one telemetry snapshot of a real-time run; shares over the run
+ * (or the virtual clock) are where strict "ontime" belongs.
+ */
+export const KEEPING_UP: readonly string[] = ["ontime", "stumbling"];

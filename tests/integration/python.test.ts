@@ -9,7 +9,7 @@ import { spawnSync } from "node:child_process";
 import { copyFileSync, readFileSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
 import { describe, expect, test } from "vitest";
-import { jsonLines, requireBuild, ROOT, runCli, startCli, tempDir } from "./helpers";
+import { jsonLines, KEEPING_UP, requireBuild, ROOT, runCli, startCli, tempDir } from "./helpers";
 
 const FIXTURES = join(ROOT, "tests", "integration", "python");
 
@@ -202,7 +202,7 @@ Other: { Type: Function, Inputs: [Emg], Params: { Operation: abs } }
     // Running again: on time, or stumbling when a call ran past its budget on a loaded machine.
     expect(["ontime", "stumbling"], last.text).toContain(last.status);
     const other = tel.at(-1)!.blocks.find((b) => b.name === "Other")!;
-    expect(other.status).toBe("ontime");
+    expect(KEEPING_UP).toContain(other.status);
     // The Python block kept going after the restart: most of the 9 s were served.
     expect(last.events).toBeGreaterThan(50 * 5);
   }, 120_000);

@@ -20,6 +20,7 @@ import {
   until,
   workdir,
 } from "./python/support";
+import { KEEPING_UP } from "../integration/helpers";
 
 let marker = "";
 afterEach(() => killMarked(marker));
@@ -71,9 +72,9 @@ Other: { Type: Function, Inputs: [Emg], Params: { Operation: abs } }
     expect(last.errors).toBeGreaterThanOrEqual(1);
     expect(last.text).toMatch(/[1-9]\d* restarts?\b/);
     expect(last.text).toMatch(/[1-9]\d* over budget/);
-    // The other branch never noticed.
+    // The other branch never noticed (it keeps up; stumbling once on a loaded machine is not lag).
     const other = summaryOf(cli.stdout()).blocks.find((b) => b.name === "Other")!;
-    expect(other.status).toBe("ontime");
+    expect(KEEPING_UP).toContain(other.status);
     // A killed call is an error: the run says so in its exit code.
     expect(code, cli.stderr()).toBe(1);
   }, 40_000);
