@@ -78,6 +78,28 @@ export interface Resources {
    * message saying what is wrong (not found, no permission, outside the allowed folders).
    */
   openRead?(path: string): FileReadHandle;
+  /**
+   * Creates a binary file to write in pieces, synchronously (a recorder's XDF or EDF+ file; its
+   * folders are created). An existing file is an error unless `overwrite`. Absent where the host
+   * cannot write files (browsers: recorders download instead). Throws with a message saying what
+   * is wrong (exists, no permission, disk full, outside the allowed folders).
+   */
+  openWrite?(path: string, options?: { overwrite?: boolean }): FileWriteHandle;
+}
+
+/** A file created by `Resources.openWrite`; each call reaches the operating system at once. */
+export interface FileWriteHandle {
+  /** The full path, for messages. */
+  readonly path: string;
+  /** Bytes appended so far. */
+  readonly size: number;
+  /** Appends `bytes` at the end. */
+  write(bytes: Uint8Array): void;
+  /** Overwrites bytes already written, at byte `position` (a header's record count). */
+  writeAt(bytes: Uint8Array, position: number): void;
+  /** Asks the disk to keep what was written (fdatasync); costly: at most about once a second. */
+  sync(): void;
+  close(): void;
 }
 
 /** A file opened by `Resources.openRead`. */

@@ -3,6 +3,7 @@ import { mkdir, readFile, rename, rm, writeFile } from "node:fs/promises";
 import { basename, dirname, isAbsolute, relative, resolve, sep } from "node:path";
 import type { Resources } from "../engine/block";
 import { openFileRead } from "./file-read";
+import { openFileWrite } from "./file-write";
 
 /**
  * Writes by file. Writes to one file never overlap (two overlapping `writeFile`s to the same
@@ -141,6 +142,7 @@ export function nodeResources(baseDir: string, allowed?: AllowedFolders): Resour
       }
     },
     openRead: (p: string) => openFileRead(confine(p, "read")),
+    openWrite: (p: string, o?: { overwrite?: boolean }) => openFileWrite(confine(p, "write"), o),
     writeText: async (p: string, text: string) => {
       const full = confine(p, "write");
       try {
