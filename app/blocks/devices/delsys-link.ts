@@ -6,7 +6,8 @@
  * connect the EMG data port, send START, then parse the float32 stream (delsys-protocol.ts) and
  * hand the selected sensors' values over in the batches they arrived in. A failure at any step
  * (refused, closed, a reply missing for `REPLY_TIMEOUT` s) closes both connections, says why, and
- * tries again after 0.5 s, 1 s, 2 s, 4 s, then every 5 s; `close` sends STOP first.
+ * tries again after 0.5 s, 1 s, 2 s, 4 s, then every 5 s (stream-link.ts's policy); `close` sends
+ * STOP first.
  *
  * `delsysProtocol` wraps it as the `DeviceProtocol` of the timer-paced form (paced-device.ts).
  */
@@ -20,12 +21,10 @@ import {
   TRIGNO_TERMINATOR,
   TrignoEmgParser,
 } from "./delsys-protocol";
+import { connectingText, failureHead, noTcpMessage, retryWait } from "./stream-link";
 
 /** Seconds a command may wait for its reply (and the connection for its banner). */
 export const REPLY_TIMEOUT = 3;
-/** Waits between attempts, s: doubling from the first up to the last. */
-export const RETRY_FIRST = 0.5;
-export const RETRY_MAX = 5;
 /** What to do without the device (said once, when the first attempt fails). */
 export const NO_DEVICE_HINT =
   "retrying until it answers (without the device: mosaic run --simulate-devices, or a simulated TCU: mosaic simulate delsys)";
@@ -213,12 +212,8 @@ export class TrignoLink {
     const wasStreaming = this.started;
     this.teardown(false);
     this.counts.failures++;
-    const wait = Math.min(RETRY_MAX, RETRY_FIRST * 2 ** (this.counts.failures - 1));
-    const head = this.everStreamed
-      ? wasStreaming
-        ? `lost ${this.target}: ${reason}`
-        : `still lost: ${reason}`
-      : `not reachable: ${reason}`;
+    const wait = retryWait(this.counts.failures);
+    const head = failureHead(this.target, reason, this.everStreamed, wasStreaming);
     this.ev.state("lost", `${head}; retrying in ${wait} s (attempt ${this.counts.failures + 1})`);
     if (wasStreaming) this.ev.warn(`lost ${this.target}: ${reason}; reconnecting`);
     else if (this.counts.failures === 1 && !this.everStreamed) {
@@ -232,12 +227,7 @@ export class TrignoLink {
 
   private attempt(): void {
     const gen = ++this.gen;
-    this.ev.state(
-      "connecting",
-      this.counts.failures > 0
-        ? `connecting to ${this.target} (attempt ${this.counts.failures + 1})…`
-        : `connecting to ${this.target}…`,
-    );
+    this.ev.state("connecting", connectingText(this.target, this.counts.failures));
     this.cmd = this.tcp.connect(
       { host: this.o.host, port: this.o.commandPort },
       {
@@ -411,11 +401,6 @@ export class TrignoLink {
     }
     this.ev.started?.(this.counts.rate, reconnected);
   }
-}
-
-/** The sentence for a host without TCP (the browser build). */
-export function noTcpMessage(target: string): string {
-  return `TCP not available in the browser build; use --simulate-devices (or the app's Simulate devices switch): ${target} cannot be reached and this block sends zeros`;
 }
 
 /** The protocol module of the timer-paced form: every sample goes to the paced device's queue. */

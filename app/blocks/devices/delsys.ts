@@ -10,7 +10,8 @@ import {
   TRIGNO_NATIVE_SAMPLES,
   TRIGNO_SENSORS,
 } from "./delsys-protocol";
-import { delsysProtocol, noTcpMessage, TrignoLink, type TrignoLinkOptions } from "./delsys-link";
+import { delsysProtocol, TrignoLink, type TrignoLinkOptions } from "./delsys-link";
+import { noTcpMessage } from "./stream-link";
 import { pacedDevice, pacingTimer } from "./paced-device";
 
 const sensorNumber = z.number().int().min(1).max(TRIGNO_SENSORS);

@@ -11,20 +11,12 @@
  *   falls silent is reported and the block waits for it to connect again (a new connection
  *   replaces a dead one); a port that cannot be listened on is retried the same way.
  *
- * Both hand every sample's raw int16 values to `samples` and count what the parser found: samples,
- * samples the device skipped (its counter jumped), malformed data (bytes skipped to realign),
- * connections that ended inside a sample, reconnections.
+ * Both are `StreamLink`s (stream-link.ts): they hand every sample's raw int16 values to `samples`
+ * and count what the parser found: samples, samples the device skipped (its counter jumped),
+ * malformed data (bytes skipped to realign), connections that ended inside a sample,
+ * reconnections.
  */
-import {
-  vectorShape,
-  type BlockContext,
-  type BlockInstance,
-  type TcpBridge,
-  type TcpServerHandle,
-  type TcpSocketHandle,
-} from "../../engine";
-import { plural, TextThrottle } from "../shared/text";
-import { DeviceClock } from "./delsys-protocol";
+import type { BlockContext, TcpBridge, TcpServerHandle, TcpSocketHandle } from "../../engine";
 import type { DeviceProtocol, DeviceSampleSink } from "./paced-device";
 import {
   MUOVI_CHANNELS,
@@ -39,220 +31,10 @@ import {
   syncStationStart,
   syncStationStop,
 } from "./muovi-protocol";
+import { connectingText, noTcpMessage, StreamLink, type LinkEvents } from "./stream-link";
 
-/** Seconds without data after which a connection counts as lost. */
-export const SILENCE = 2;
-/** Waits between attempts, s: doubling from the first up to the last. */
-export const RETRY_FIRST = 0.5;
-export const RETRY_MAX = 5;
 /** Seconds a listening probe link waits before it warns that no probe connected. */
 export const WAIT_WARNING = 5;
-/** How often the link looks at its deadlines, s. */
-const HEARTBEAT = 0.1;
-
-export type MuoviPhase = "connecting" | "streaming" | "lost";
-
-export interface MuoviLinkEvents {
-  /** One sample's raw values (all channels on the wire; valid during the call). */
-  samples(raw: Int16Array): void;
-  state(phase: MuoviPhase, text: string): void;
-  warn(message: string): void;
-  /** The samples of one TCP chunk have all been given (the native form emits them as a frame). */
-  chunkEnd?(): void;
-}
-
-export interface MuoviCounts {
-  samples: number;
-  /** Samples the device skipped (its counter jumped ahead). */
-  lostSamples: number;
-  /** Times the counter restarted (or jumped too far to count the samples in between). */
-  counterJumps: number;
-  malformed: number;
-  skippedBytes: number;
-  lastProblem: string;
-  /** Connections that ended inside a sample, and the bytes lost that way. */
-  truncated: number;
-  truncatedBytes: number;
-  reconnections: number;
-  failures: number;
-}
-
-/** What both links share: the parser, the counts, the heartbeat, retries. */
-abstract class MuoviLinkBase {
-  protected gen = 0;
-  protected closed = true;
-  protected streaming = false;
-  protected everStreamed = false;
-  protected lastData = 0;
-  protected retryAt = -1;
-  protected readonly parser: MuoviStreamParser;
-  readonly counts: MuoviCounts = {
-    samples: 0,
-    lostSamples: 0,
-    counterJumps: 0,
-    malformed: 0,
-    skippedBytes: 0,
-    lastProblem: "",
-    truncated: 0,
-    truncatedBytes: 0,
-    reconnections: 0,
-    failures: 0,
-  };
-
-  constructor(
-    protected readonly ctx: BlockContext,
-    protected readonly tcp: TcpBridge,
-    channels: number,
-    protected readonly ev: MuoviLinkEvents,
-  ) {
-    this.parser = new MuoviStreamParser(channels, (raw) => ev.samples(raw));
-  }
-
-  /** "the SyncStation at 192.168.76.1:54320". */
-  abstract get target(): string;
-  protected abstract attempt(): void;
-  /** Closes the transport (the stop command first when `stop`). */
-  protected abstract drop(stop: boolean): void;
-
-  open(): void {
-    if (!this.closed) return;
-    this.closed = false;
-    this.counts.failures = 0;
-    this.attempt();
-    this.heartbeat();
-  }
-
-  close(): void {
-    if (this.closed) return;
-    this.closed = true;
-    this.gen++;
-    this.drop(true);
-    this.endStream();
-  }
-
-  private heartbeat(): void {
-    if (this.closed) return;
-    const now = this.ctx.now();
-    if (this.retryAt >= 0 && now >= this.retryAt) {
-      this.retryAt = -1;
-      this.attempt();
-    } else if (this.watching() && now - this.lastData > SILENCE) {
-      this.fail(this.gen, `no data for ${SILENCE} s`);
-    } else this.idle(now);
-    this.ctx.at(this.ctx.now() + HEARTBEAT, () => this.heartbeat());
-  }
-
-  /** Called on heartbeats with nothing else to do. */
-  protected idle(_now: number): void {}
-
-  /** Whether silence counts now (a connection is up and configured). */
-  protected abstract watching(): boolean;
-
-  protected onData(gen: number, chunk: Uint8Array): void {
-    if (gen !== this.gen || this.closed) return;
-    this.lastData = this.ctx.now();
-    const p = this.parser;
-    const before = p.malformed;
-    p.feed(chunk);
-    const c = this.counts;
-    c.samples = p.samples;
-    c.lostSamples = p.lostSamples;
-    c.counterJumps = p.counterJumps;
-    c.malformed = p.malformed;
-    c.skippedBytes = p.skippedBytes;
-    c.lastProblem = p.lastProblem;
-    if (p.malformed > before) {
-      this.ev.warn(
-        `malformed data from ${this.target} (${p.lastProblem}): skipping to the next whole sample (${p.malformed} so far)`,
-      );
-    }
-    if (!this.streaming && p.samples > 0) this.began();
-    else if (this.streaming && this.extras() !== this.shownExtras) {
-      this.ev.state("streaming", this.statusText());
-    }
-    this.ev.chunkEnd?.();
-  }
-
-  private shownExtras = "";
-
-  /** The counts worth seeing in the status line: " · 3 skipped by the device · …". */
-  private extras(): string {
-    const c = this.counts;
-    let t = "";
-    if (c.lostSamples > 0) t += ` · ${c.lostSamples} samples skipped by the device`;
-    if (c.malformed > 0) t += ` · ${c.malformed} malformed (${c.skippedBytes} bytes skipped)`;
-    if (c.truncated > 0) t += ` · ${c.truncated} truncated`;
-    if (c.reconnections > 0) t += ` · reconnected ${c.reconnections}×`;
-    return t;
-  }
-
-  private statusText(): string {
-    this.shownExtras = this.extras();
-    return this.streamingText() + this.shownExtras;
-  }
-
-  private began(): void {
-    this.streaming = true;
-    const reconnected = this.everStreamed;
-    if (reconnected) this.counts.reconnections++;
-    this.everStreamed = true;
-    const attempts = this.counts.failures;
-    this.counts.failures = 0;
-    this.ev.state("streaming", this.statusText());
-    if (reconnected) {
-      this.ev.warn(
-        `reconnected to ${this.target} after ${attempts} failed attempt${attempts === 1 ? "" : "s"}; streaming again`,
-      );
-    }
-  }
-
-  protected abstract streamingText(): string;
-
-  /** The stream ended: what the parser held is a truncated sample. */
-  protected endStream(): void {
-    const wasStreaming = this.streaming;
-    this.streaming = false;
-    const held = this.parser.reset();
-    if (held > 0 && wasStreaming) {
-      this.counts.truncated++;
-      this.counts.truncatedBytes += held;
-      if (!this.closed) {
-        this.ev.warn(
-          `the stream from ${this.target} ended inside a sample (${held} of ${this.parser.sampleBytes} bytes): dropped`,
-        );
-      }
-    }
-  }
-
-  /** Something failed: close, say why, try again later. */
-  protected fail(gen: number, reason: string): void {
-    if (gen !== this.gen || this.closed) return;
-    const wasStreaming = this.streaming;
-    this.gen++;
-    this.drop(false);
-    this.endStream();
-    this.counts.failures++;
-    const wait = Math.min(RETRY_MAX, RETRY_FIRST * 2 ** (this.counts.failures - 1));
-    const head = this.everStreamed
-      ? wasStreaming
-        ? `lost ${this.target}: ${reason}`
-        : `still lost: ${reason}`
-      : `not reachable: ${reason}`;
-    this.ev.state("lost", `${head}; ${this.retryText(wait)}`);
-    if (wasStreaming) this.ev.warn(`lost ${this.target}: ${reason}; reconnecting`);
-    else if (this.counts.failures === 1 && !this.everStreamed) {
-      this.ev.warn(`${this.target} ${head}; ${this.hint()}`);
-    }
-    this.retryAt = this.ctx.now() + wait;
-  }
-
-  protected abstract hint(): string;
-
-  /** What happens next, for the status: "retrying in 1 s (attempt 3)". */
-  protected retryText(wait: number): string {
-    return `retrying in ${wait} s (attempt ${this.counts.failures + 1})`;
-  }
-}
 
 export interface SyncStationLinkOptions {
   host: string;
@@ -262,7 +44,7 @@ export interface SyncStationLinkOptions {
 }
 
 /** The SyncStation: this computer is its TCP client (see the file comment). */
-export class SyncStationLink extends MuoviLinkBase {
+export class SyncStationLink extends StreamLink {
   private sock: TcpSocketHandle | undefined;
   private connected = false;
 
@@ -270,9 +52,10 @@ export class SyncStationLink extends MuoviLinkBase {
     ctx: BlockContext,
     tcp: TcpBridge,
     private readonly o: SyncStationLinkOptions,
-    ev: MuoviLinkEvents,
+    ev: LinkEvents,
   ) {
-    super(ctx, tcp, syncStationChannels(o.slots.length), ev);
+    const channels = syncStationChannels(o.slots.length);
+    super(ctx, tcp, (onSample) => new MuoviStreamParser(channels, onSample), ev);
   }
 
   get target(): string {
@@ -295,12 +78,7 @@ export class SyncStationLink extends MuoviLinkBase {
 
   protected attempt(): void {
     const gen = ++this.gen;
-    this.ev.state(
-      "connecting",
-      this.counts.failures > 0
-        ? `connecting to ${this.target} (attempt ${this.counts.failures + 1})…`
-        : `connecting to ${this.target}…`,
-    );
+    this.ev.state("connecting", connectingText(this.target, this.counts.failures));
     this.sock = this.tcp.connect(
       { host: this.o.host, port: this.o.port },
       {
@@ -334,7 +112,7 @@ export interface MuoviProbeLinkOptions {
 }
 
 /** A single probe: this computer listens and the probe connects (see the file comment). */
-export class MuoviProbeLink extends MuoviLinkBase {
+export class MuoviProbeLink extends StreamLink {
   private server: TcpServerHandle | undefined;
   private peer: TcpSocketHandle | undefined;
   private peerName = "";
@@ -344,9 +122,9 @@ export class MuoviProbeLink extends MuoviLinkBase {
     ctx: BlockContext,
     tcp: TcpBridge,
     private readonly o: MuoviProbeLinkOptions,
-    ev: MuoviLinkEvents,
+    ev: LinkEvents,
   ) {
-    super(ctx, tcp, MUOVI_WIRE_CHANNELS, ev);
+    super(ctx, tcp, (onSample) => new MuoviStreamParser(MUOVI_WIRE_CHANNELS, onSample), ev);
   }
 
   get target(): string {
@@ -456,11 +234,6 @@ export class MuoviProbeLink extends MuoviLinkBase {
   }
 }
 
-/** The sentence for a host without TCP (the browser build). */
-export function noTcpMessage(target: string): string {
-  return `TCP not available in the browser build; use --simulate-devices (or the app's Simulate devices switch): ${target} cannot be reached and this block sends zeros`;
-}
-
 /**
  * The SyncStation as the timer-paced Muovi block's protocol module: every `averageOver` raw
  * samples become one sample of 32 EMG channels per probe (in the order of `Probes`), each the
@@ -551,119 +324,6 @@ export function muoviProbeProtocol(
       onLink?.(l);
       l.open();
       return { close: () => l.close() };
-    },
-  };
-}
-
-/** One line of counts, for the blocks' `counts` action. */
-export function muoviCountsText(c: MuoviCounts | undefined): string {
-  if (!c) return "not started";
-  return (
-    `${c.samples} samples, ${c.lostSamples} skipped by the device, ${c.counterJumps} counter restarts, ${c.reconnections} reconnections, ` +
-    `${c.malformed} malformed (${c.skippedBytes} bytes skipped${c.lastProblem ? `, last: ${c.lastProblem}` : ""}), ` +
-    `${c.truncated} truncated (${c.truncatedBytes} bytes)`
-  );
-}
-
-export interface NativeMuoviOptions {
-  /** Output channels (vector [1, channels] per sample). */
-  channels: number;
-  /** "the SyncStation at …", for the no-TCP message. */
-  target: string;
-  /** Whether this host can reach the device (a TCP bridge, with listen when needed). */
-  available(ctx: BlockContext): boolean;
-  /** Opens the link with these events (the bridge is available). */
-  open(ctx: BlockContext, ev: MuoviLinkEvents): { close(): void };
-  /** Writes one sample's output values from its raw values at `out[at…]`. */
-  convert(raw: Int16Array, out: Float64Array, at: number): void;
-}
-
-/**
- * The blocks without an input: their own source at the device's 2000 Hz. The samples of each TCP
- * chunk go out at once as one frame, stamped on the device's sample clock (the first batch's last
- * sample at its arrival, then 1 / 2000 s apart, at most one SyncStation packet, 20 ms, ahead of
- * arrival; re-anchored after a loss, the gap counted).
- */
-export function nativeMuoviSource(ctx: BlockContext, o: NativeMuoviOptions): BlockInstance {
-  if (ctx.declaredRate === undefined) ctx.setDesiredRate(MUOVI_RATE);
-  const k = o.channels;
-  const out = ctx.output(vectorShape(k), "emg");
-  const clock = new DeviceClock(MUOVI_RATE, 0.5, 40 / MUOVI_RATE);
-  const throttle = new TextThrottle(0.5);
-  let batch = new Float64Array(64 * k);
-  let n = 0;
-  let emitted = 0;
-  let phase = "stopped";
-  let lastText = "";
-  let link: { close(): void } | undefined;
-
-  const refresh = (): void => {
-    let text = phase;
-    if (emitted > 0) text += ` · ${plural(emitted, "sample")}`;
-    if (clock.gapSamples > 0) text += ` · ${clock.gapSamples} samples lost in gaps`;
-    if (text !== lastText) {
-      lastText = text;
-      ctx.setText(text);
-    }
-  };
-
-  const events: MuoviLinkEvents = {
-    samples(raw) {
-      if ((n + 1) * k > batch.length) {
-        const bigger = new Float64Array(batch.length * 2);
-        bigger.set(batch);
-        batch = bigger;
-      }
-      o.convert(raw, batch, n * k);
-      n++;
-    },
-    chunkEnd() {
-      if (n === 0) return;
-      const f = out.frame(n);
-      clock.stamp(ctx.now(), f.t, n);
-      f.v.set(batch.subarray(0, n * k));
-      out.emit(f);
-      emitted += n;
-      n = 0;
-      if (throttle.due(ctx.now())) refresh();
-    },
-    state(p, text) {
-      if (p !== "streaming") {
-        clock.restart();
-        n = 0;
-      }
-      phase = text;
-      refresh();
-    },
-    warn: (m) => ctx.warn(m),
-  };
-
-  refresh();
-  return {
-    start() {
-      if (!o.available(ctx)) {
-        phase = "TCP not available in the browser build; use --simulate-devices";
-        refresh();
-        ctx.warn(noTcpMessage(o.target));
-        return;
-      }
-      link = o.open(ctx, events);
-    },
-    stop() {
-      link?.close();
-      link = undefined;
-      phase = "stopped";
-      refresh();
-    },
-    reset() {
-      clock.reset();
-      emitted = 0;
-      throttle.reset();
-      refresh();
-    },
-    dispose() {
-      link?.close();
-      link = undefined;
     },
   };
 }

@@ -8,12 +8,8 @@ import {
 } from "../../engine";
 import { pacedDevice, pacingTimer } from "./paced-device";
 import { MUOVI_CHANNELS, MUOVI_PROBE_PORT, MUOVI_RATE } from "./muovi-protocol";
-import {
-  muoviCountsText,
-  muoviProbeProtocol,
-  MuoviProbeLink,
-  nativeMuoviSource,
-} from "./muovi-link";
+import { muoviProbeProtocol, MuoviProbeLink } from "./muovi-link";
+import { linkCountsText, nativeStreamSource } from "./stream-link";
 import { MUOVI_MV_PER_BIT } from "./muovi-protocol";
 
 const params = z.strictObject({
@@ -92,7 +88,7 @@ export const MuoviSingleProbe = defineBlock({
         label: "Counts",
         description:
           "Samples, samples the probe skipped, malformed and truncated data, reconnections",
-        run: () => muoviCountsText(link?.counts),
+        run: () => linkCountsText(link?.counts),
       },
     };
     if (p.Probes.length > 1) {
@@ -102,7 +98,9 @@ export const MuoviSingleProbe = defineBlock({
     }
     if (ctx.inputs.length === 0) {
       const cols = MUOVI_CHANNELS * p.Probes.length;
-      const instance = nativeMuoviSource(ctx, {
+      const instance = nativeStreamSource(ctx, {
+        rate: MUOVI_RATE,
+        maxLead: 0.02,
         channels: cols,
         target: `a Muovi probe on TCP port ${p.Port}`,
         available: (c) => c.io.tcp?.listen !== undefined,

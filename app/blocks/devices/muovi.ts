@@ -14,7 +14,8 @@ import {
   MUOVI_RATE,
   SYNCSTATION_MUOVI_SLOTS,
 } from "./muovi-protocol";
-import { muoviCountsText, muoviProtocol, nativeMuoviSource, SyncStationLink } from "./muovi-link";
+import { muoviProtocol, SyncStationLink } from "./muovi-link";
+import { linkCountsText, nativeStreamSource } from "./stream-link";
 import { MUOVI_FULL_SCALE, slotOffsets } from "./muovi-protocol";
 
 const params = z.strictObject({
@@ -101,13 +102,15 @@ export const Muovi = defineBlock({
         label: "Counts",
         description:
           "Samples, samples the SyncStation skipped, malformed and truncated data, reconnections",
-        run: () => muoviCountsText(link?.counts),
+        run: () => linkCountsText(link?.counts),
       },
     };
     if (ctx.inputs.length === 0) {
       const offsets = slotOffsets(p.Probes);
       const o = { host: p.Host, port: p.Port, slots: p.Probes };
-      const instance = nativeMuoviSource(ctx, {
+      const instance = nativeStreamSource(ctx, {
+        rate: MUOVI_RATE,
+        maxLead: 0.02,
         channels: MUOVI_CHANNELS * offsets.length,
         target: `the SyncStation at ${p.Host}:${p.Port}`,
         available: (c) => c.io.tcp !== undefined,
