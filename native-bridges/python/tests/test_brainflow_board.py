@@ -1,0 +1,141 @@
+"""mosaic_blocks.brainflow_board (the BrainFlow block's module), called as the sidecar calls it,
+on BrainFlow's own synthetic and playback boards (real BrainFlow sessions; no device needed)."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from mosaic_blocks import brainflow_board as B
+
+POLL = np.ones((1, 1))
+STOP = np.full((1, 1), 2.0)
+DESCRIBE = np.zeros((1, 1))
+
+
+def drain(state: B.Reader, seconds: float, until=None) -> tuple[np.ndarray, np.ndarray]:
+    """Polls every 20 ms for `seconds` (or until `until(header)`): (samples, last header)."""
+    rows, header = [], None
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < seconds:
+        r = B.poll(POLL, state)
+        header = r[0]
+        n = int(header[B.H_N])
+        rows.append(r[1 : 1 + n, : int(header[B.H_CHANNELS])].copy())
+        if until is not None and until(header):
+            break
+        time.sleep(0.02)
+    return np.concatenate(rows), header
+
+
+def test_board_names_numbers_and_did_you_mean():
+    shim, _ = B.library("brainflow")
+    assert B.board_id(shim, "SYNTHETIC_BOARD", "brainflow") == -1
+    assert B.board_id(shim, "synthetic", "brainflow") == -1
+    assert B.board_id(shim, "playback", "brainflow") == -3
+    assert B.board_id(shim, -1, "brainflow") == -1
+    assert B.board_id(shim, "16", "brainflow") == 16  # GFORCE_PRO_BOARD
+    with pytest.raises(ValueError, match=r"no board named 'cyton_dasy'; did you mean CYTON_DAISY_BOARD"):
+        B.board_id(shim, "cyton_dasy", "brainflow")
+    with pytest.raises(ValueError, match=r"no board number 12345"):
+        B.board_id(shim, 12345, "brainflow")
+    # Mindrove's fork has its own ids: a MINDROVE name picks it.
+    assert B.library_of("MINDROVE_WIFI_BOARD", "auto") == "mindrove"
+    mshim, _ = B.library("mindrove")
+    assert B.board_id(mshim, "mindrove_wifi", "mindrove") == int(mshim.BoardIds.MINDROVE_WIFI_BOARD)
+
+
+def test_layout_and_describe():
+    state = B.init({"board": "synthetic", "channels": ["exg", "accel", "package"], "poll_rate": 50})
+    r = B.poll(DESCRIBE, state)
+    # 16 EXG + 3 accel + the package number, at 250 Hz; up to 4 polls of samples (at least 32).
+    assert r.shape == (1 + 32, 20)
+    assert r[0, B.H_RATE] == 250 and r[0, B.H_CHANNELS] == 20 and r[0, B.H_N] == 0
+    assert list(r[1, :3]) == [16, 3, 1]
+    assert state.thread is None  # describing opens nothing
+    with pytest.raises(ValueError, match="no gyro channels"):
+        B.init({"board": "cyton", "channels": ["gyro"]})
+    with pytest.raises(ValueError, match="need master_board"):
+        B.init({"board": "playback", "input": {"file": "x.csv"}})
+    with pytest.raises(ValueError, match="playback file .* does not exist"):
+        B.init({"board": "playback", "master_board": "synthetic", "input": {"file": "/nonexistent.csv"}})
+
+
+def test_synthetic_every_sample_once_at_its_rate():
+    state = B.init({"board": "synthetic", "channels": ["exg", "package"], "max_rows": 8})
+    try:
+        t0 = time.monotonic()
+        data, header = drain(state, 2.0)
+        elapsed = time.monotonic() - t0
+    finally:
+        B.poll(STOP, state)
+    package = data[:, -1]
+    # Consecutive package numbers (0…255, wrapping): nothing lost, nothing repeated, even though a
+    # poll returns at most 8 rows and the rest waits for the next.
+    assert np.all(np.diff(package) % 256 == 1)
+    assert header[B.H_LOST] == 0 and header[B.H_STATE] == B.STREAMING
+    # Its rate: 250 Hz over the time polled (the board starts on the first poll).
+    assert 250 * (elapsed - 0.6) < len(data) <= 250 * elapsed + 10
+
+
+def test_playback_gives_the_file_exactly(tmp_path):
+    shim, params_class = B.library("brainflow")
+    from brainflow.data_filter import DataFilter
+
+    board = shim.BoardShim(int(shim.BoardIds.SYNTHETIC_BOARD), params_class())
+    board.prepare_session()
+    board.start_stream()
+    time.sleep(1.0)
+    recorded = board.get_board_data()
+    board.stop_stream()
+    board.release_session()
+    path = str(tmp_path / "rec.csv")
+    DataFilter.write_file(recorded, path, "w")
+    expected = DataFilter.read_file(path)  # what the file holds (written with 6 decimals)
+    state = B.init(
+        {
+            "board": "playback",
+            "master_board": "synthetic",
+            "input": {"file": path},
+            "channels": ["exg", "package"],
+            "silence": 0.5,
+        }
+    )
+    try:
+        data, header = drain(state, 10.0, until=lambda h: h[B.H_STATE] == B.ENDED)
+    finally:
+        B.poll(STOP, state)
+    assert header[B.H_STATE] == B.ENDED
+    rows = B.layout(shim, -1, ["exg", "package"])["rows"]
+    assert np.array_equal(data, expected[rows].T)
+
+
+def test_wrong_serial_port_is_a_clear_error_once_and_retried():
+    state = B.init({"board": "cyton", "input": {"serial_port": "/dev/ttyMOSAIC_NONE"}, "retry": 0.05})
+    raised = []
+    try:
+        t0 = time.monotonic()
+        header = None
+        while time.monotonic() - t0 < 1.5:
+            try:
+                header = B.poll(POLL, state)[0]
+            except RuntimeError as e:
+                raised.append(str(e))
+            time.sleep(0.02)
+    finally:
+        B.poll(STOP, state)
+    assert len(raised) == 1
+    assert "UNABLE_TO_OPEN_PORT_ERROR" in raised[0] and "serial port" in raised[0]
+    assert header is not None and header[B.H_FAILURES] >= 3
+
+
+def test_gaps_in_package_numbers():
+    state = B.init({"board": "synthetic"})
+    state.count_gaps(np.array([0.0, 1, 2, 5, 6]))  # 3, 4 missing
+    assert state.lost == 2
+    state.count_gaps(np.array([7.0, 9]))  # 8 missing, across calls
+    assert state.lost == 3
+    state.count_gaps(np.array([255.0, 0, 1]))  # 10…254 missing, then a wrap without loss
+    assert state.lost == 3 + 245
