@@ -37,7 +37,7 @@ await build({
   splitting: true,
   chunkNames: "chunks/[name]-[hash]",
   // Native modules cannot be bundled.
-  external: ["serialport", "@serialport/*", "@abandonware/noble", "electron"],
+  external: ["serialport", "@serialport/*", "@abandonware/noble", "electron", "koffi"],
 });
 await build({
   ...common,

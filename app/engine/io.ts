@@ -330,6 +330,82 @@ export interface PythonBridge {
   load(options: PythonLoadOptions): Promise<PythonSidecar>;
 }
 
+/**
+ * Lab Streaming Layer (liblsl through an FFI; native-bridges/lsl.ts). Times are LSL's clock
+ * (`localClock`, seconds of a monotonic clock shared by the processes of one machine); blocks map
+ * them onto the pipeline clock. Every method may throw an `Error` whose message says what is
+ * wrong (the library not found, with where it was looked for; a bad predicate): blocks catch it
+ * and show it in their status.
+ */
+export type LslFormat = "float32" | "double64" | "int32" | "int16" | "string";
+
+/** What a stream says about itself (an outlet's declaration, or a stream found by a resolver). */
+export interface LslStreamInfo {
+  name: string;
+  type: string;
+  channels: number;
+  /** Nominal sampling rate, Hz; 0 for an irregular stream (markers). */
+  rate: number;
+  /** Formats this bridge does not handle (int8, int64) read as `other`. */
+  format: LslFormat | "other";
+  sourceId: string;
+  /** Channel labels (outlets: written into the stream's description). */
+  labels?: readonly string[];
+  /** Where the stream was found (resolved streams only). */
+  hostname?: string;
+  uid?: string;
+}
+
+export interface LslOutletHandle {
+  /**
+   * Pushes `n` samples as one chunk: `values` row-major (`n * channels`, already in range for an
+   * integer format), `timestamps[i]` on LSL's clock. Numeric formats only.
+   */
+  push(values: Float64Array, n: number, timestamps: Float64Array): void;
+  /** Pushes one chunk of string samples (`values.length / channels` samples). */
+  pushStrings(values: readonly string[], timestamps: Float64Array): void;
+  /** True while at least one inlet is connected. */
+  haveConsumers(): boolean;
+  close(): void;
+}
+
+export interface LslInletHandle {
+  /**
+   * Pulls what is buffered (never waits), at most `max` samples, into `values` (row-major) and
+   * `timestamps` (the sender's clock); returns how many, or -1 when the stream is lost and cannot
+   * be recovered (then close this inlet and resolve again).
+   */
+  pull(values: Float64Array, timestamps: Float64Array, max: number): number;
+  /** As `pull` for a string stream: the strings of the samples pulled, in order. */
+  pullStrings(into: string[], timestamps: Float64Array, max: number): number;
+  /**
+   * The latest clock offset: add it to a sender timestamp to get this machine's LSL time, with
+   * its uncertainty (the round trip, s); undefined until liblsl has a first estimate (it asks in
+   * the background; never waits).
+   */
+  timeCorrection(): { offset: number; uncertainty: number } | undefined;
+  close(): void;
+}
+
+/** A continuous resolver: the streams matching a predicate, kept current in the background. */
+export interface LslResolverHandle {
+  /** The streams seen now (never waits). */
+  results(): LslStreamInfo[];
+  /** Opens an inlet on a stream of `results()` (by uid); `bufferS`: seconds liblsl may buffer. */
+  openInlet(stream: LslStreamInfo, options: { bufferS: number; recover: boolean }): LslInletHandle;
+  close(): void;
+}
+
+export interface LslBridge {
+  /** "liblsl 1.18 (/path/to/liblsl.so)". */
+  readonly version: string;
+  /** LSL's clock now, s. */
+  localClock(): number;
+  createOutlet(info: LslStreamInfo, options: { bufferS: number }): LslOutletHandle;
+  /** Starts resolving streams that match an XPath predicate such as `name='EMG' and type='EMG'`. */
+  resolve(predicate: string): LslResolverHandle;
+}
+
 /** Every bridge the host could provide (all optional). Issue 6 fills these in. */
 export interface IoBridges {
   udp?: UdpBridge;
@@ -338,6 +414,8 @@ export interface IoBridges {
   ble?: BleBridge;
   ros?: RosBridge;
   python?: PythonBridge;
+  /** Lab Streaming Layer (liblsl); absent in the browser build. */
+  lsl?: LslBridge;
   /** Bluetooth LE and ROS bridges are declared by their blocks' issue (6). */
   [name: string]: unknown;
 }

@@ -21,6 +21,7 @@ import { RealtimeLoop } from "../engine/runtime/loop";
 import { serialProxy } from "../../native-bridges/serial-proxy";
 import { bleProxy } from "../../native-bridges/ble-proxy";
 import { nodeRosBridge } from "../../native-bridges/ros";
+import { nodeLslBridge } from "../../native-bridges/lsl";
 import { nodeTcpBridge } from "../../native-bridges/tcp";
 import { nodeUdpBridge } from "../../native-bridges/udp";
 import { createPythonBridge } from "../../native-bridges/python";
@@ -116,6 +117,7 @@ async function create(msg: InitMessage): Promise<void> {
       serial: serial.bridge,
       ble: ble.bridge,
       python: createPythonBridge(),
+      lsl: nodeLslBridge(),
     },
     logs: sabLogSink(virtual),
     worker: msg.worker,

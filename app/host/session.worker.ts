@@ -34,6 +34,7 @@ import { EngineSession, type LoopHooks } from "../engine/session";
 import { bleProxy } from "../../native-bridges/ble-proxy";
 import { nodeRosBridge } from "../../native-bridges/ros";
 import { serialProxy } from "../../native-bridges/serial-proxy";
+import { nodeLslBridge } from "../../native-bridges/lsl";
 import { nodeTcpBridge } from "../../native-bridges/tcp";
 import { nodeUdpBridge } from "../../native-bridges/udp";
 import { createPythonBridge } from "../../native-bridges/python";
@@ -312,6 +313,7 @@ function runSession(port: MessagePort): void {
         serial: serial.bridge,
         ble: ble.bridge,
         python: createPythonBridge(),
+        lsl: nodeLslBridge(),
       },
       startLoop,
       post: (m, transfer) => post(m, transfer),
