@@ -51,6 +51,10 @@ import { Stimulus } from "./learning/stimulus";
 import { StimTrigger } from "./learning/stim-trigger";
 import { TAC } from "./learning/tac";
 import { Trigger } from "./learning/trigger";
+import { LslInlet } from "./lsl/lsl-inlet";
+import { LslMarkerInlet } from "./lsl/lsl-marker-inlet";
+import { LslMarkers } from "./lsl/lsl-markers";
+import { LslOutlet } from "./lsl/lsl-outlet";
 import { Logger } from "./recording/logger";
 import { AdaptiveFilter } from "./signal/adaptive-filter";
 import { DoubleDifferential } from "./signal/dds";
@@ -133,6 +137,10 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   HannesHand,
   HannesGUI,
   HannesReceiver,
+  LslOutlet,
+  LslInlet,
+  LslMarkers,
+  LslMarkerInlet,
   // Devices (app/blocks/devices/)
   Muovi,
   MuoviSingleProbe,
