@@ -101,8 +101,9 @@ const CPU_TARGETS: { id: string; workload: string; paper: string; limit: number 
   },
   {
     id: "delsys-tcp",
-    workload: "Delsys pipeline over TCP, Trigno simulator, 8 ch @ 1925.926 Hz",
-    paper: "not reported (the Delsys row is the paper's 32-channel figure)",
+    workload:
+      "Delsys pipeline over TCP, Trigno simulator, 32 ch (8 sensors × EMG + accelerometer) @ 1925.926 Hz",
+    paper: paperCpu(PAPER_CPU.delsys, "cores"),
     limit: 3,
   },
   { id: "hdemg", workload: "High-density EMG, 256 ch @ 2048 Hz", paper: "not reported", limit: 8 },

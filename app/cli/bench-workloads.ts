@@ -114,7 +114,7 @@ export const WORKLOADS: WorkloadDef[] = [
     kind: "pipeline",
     id: "delsys-tcp",
     title:
-      "(b′) Delsys pipeline over TCP — the Trigno simulator's 8 sensors @ 1925.926 Hz, 26 samples every 13.5 ms",
+      "(b′) Delsys pipeline over TCP — the Trigno simulator's 8 sensors × (EMG + accelerometer) = 32 ch @ 1925.926 Hz, 26 samples every 13.5 ms",
     file: "delsys-tcp.yaml",
     acquisition: "Delsys",
     udpRateHz: 25,

@@ -10,7 +10,8 @@
  * The values are deterministic: `trignoEmgValue(seed, sensor, k)` is sample k (from 0 at START)
  * of a sensor, a sine per sensor plus seeded noise, rounded to float32 as it goes on the wire, so
  * tests compare bit for bit. Faults for tests and demos: `dropConnections()` (as a TCU that
- * crashed and came back), `injectEmg(bytes)` (malformed bytes between two samples), `truncate()`
+ * crashed and came back), `injectEmg(bytes)` / `injectAux(bytes)` (malformed bytes between two
+ * samples), `truncate()`
  * (half a sample, then the connections drop).
  *
  * Pure Node (node:net); used by the tests and by `mosaic simulate delsys`.
@@ -389,6 +390,11 @@ export class TrignoSimulator {
   /** Fault: raw bytes on the EMG port now, between two samples (misaligns the stream). */
   injectEmg(bytes: Uint8Array): void {
     this.emg.write(Buffer.from(bytes));
+  }
+
+  /** Fault: raw bytes on the AUX port now, between two samples (misaligns the stream). */
+  injectAux(bytes: Uint8Array): void {
+    this.aux.write(Buffer.from(bytes));
   }
 
   /** Fault: half of one EMG sample, then every connection drops (a sample cut short). */

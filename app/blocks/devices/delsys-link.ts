@@ -13,10 +13,15 @@
  */
 import type { BlockContext, TcpBridge, TcpSocketHandle } from "../../engine";
 import type { DeviceProtocol, DeviceSampleSink } from "./paced-device";
+import { TrignoAuxJoin } from "./delsys-aux";
 import {
   hzText,
+  TRIGNO_AUX,
+  TRIGNO_AUX_PORT,
+  TRIGNO_AUX_SAMPLES,
   TRIGNO_FRAME_INTERVAL,
   TRIGNO_NATIVE_RATE,
+  TRIGNO_NATIVE_SAMPLES,
   TRIGNO_SAMPLE_BYTES,
   TRIGNO_TERMINATOR,
   TrignoEmgParser,
@@ -37,12 +42,21 @@ export interface TrignoLinkOptions {
   emgPort: number;
   /** Selected sensors (1…16), in output order. */
   sensors: readonly number[];
+  /**
+   * AUX values joined per sensor after its EMG value (0: the AUX port is not used; 3: the
+   * accelerometer; 9: accelerometer, gyroscope, magnetometer), from `auxPort`.
+   */
+  aux?: number;
+  auxPort?: number;
 }
+
+/** Output values per sample: per sensor its EMG value and its AUX values. */
+export const trignoWidth = (o: TrignoLinkOptions): number => o.sensors.length * (1 + (o.aux ?? 0));
 
 export type TrignoPhase = "connecting" | "streaming" | "lost";
 
 export interface TrignoLinkEvents {
-  /** `n` samples of `sensors.length` values each (row-major in `values`, valid during the call). */
+  /** `n` samples of `trignoWidth` values each (row-major in `values`, valid during the call). */
   samples(values: Float64Array, n: number): void;
   /** The link's state in a few words. */
   state(phase: TrignoPhase, text: string): void;
@@ -72,6 +86,8 @@ export interface TrignoCounts {
   unpaired: number[];
   /** Sensor types as the TCU gave them, by sensor number. */
   types: Record<number, string>;
+  /** The AUX stream (when used): samples, malformed, and what the join held or dropped. */
+  aux: { samples: number; malformed: number; held: number; dropped: number; perFrame: number };
 }
 
 class LinkError extends Error {}
@@ -108,7 +124,11 @@ export class TrignoLink {
     banner: "",
     unpaired: [],
     types: {},
+    aux: { samples: 0, malformed: 0, held: 0, dropped: 0, perFrame: TRIGNO_AUX_SAMPLES },
   };
+  private auxSock: TcpSocketHandle | undefined;
+  private readonly auxParser: TrignoEmgParser | undefined;
+  private readonly join: TrignoAuxJoin | undefined;
 
   constructor(
     private readonly ctx: BlockContext,
@@ -119,6 +139,15 @@ export class TrignoLink {
     this.slots = Int32Array.from(o.sensors, (s) => s - 1);
     this.batch = new Float64Array(64 * o.sensors.length);
     this.parser = new TrignoEmgParser((v) => this.onSample(v));
+    if ((o.aux ?? 0) > 0) {
+      this.join = new TrignoAuxJoin(this.slots, o.aux!, TRIGNO_NATIVE_SAMPLES, TRIGNO_AUX_SAMPLES);
+      const join = this.join;
+      this.auxParser = new TrignoEmgParser((v) => join.pushAux(v), TRIGNO_AUX);
+    }
+  }
+
+  get options(): TrignoLinkOptions {
+    return this.o;
   }
 
   /** "the Trigno Control Utility at 127.0.0.1:50040". */
@@ -142,6 +171,10 @@ export class TrignoLink {
   }
 
   private onSample(v: Float64Array): void {
+    if (this.join) {
+      this.join.pushEmg(v);
+      return;
+    }
     const k = this.slots.length;
     if ((this.batchN + 1) * k > this.batch.length) {
       const bigger = new Float64Array(this.batch.length * 2);
@@ -172,7 +205,31 @@ export class TrignoLink {
         `malformed EMG data from ${this.target} (${this.counts.lastProblem}): skipping to the next whole sample (${this.counts.malformed} so far)`,
       );
     }
-    if (this.batchN > 0) this.ev.samples(this.batch, this.batchN);
+    if (this.join) this.emitJoined();
+    else if (this.batchN > 0) this.ev.samples(this.batch, this.batchN);
+  }
+
+  private onAuxData(gen: number, chunk: Uint8Array): void {
+    const p = this.auxParser;
+    if (gen !== this.gen || !this.started || !p) return;
+    const before = p.malformed;
+    p.feed(chunk);
+    this.counts.aux.samples = p.samples;
+    this.counts.aux.malformed = p.malformed;
+    if (p.malformed > before) {
+      this.ev.warn(
+        `malformed AUX data from ${this.target} (${p.lastProblem}): skipping to the next whole sample (${p.malformed} so far)`,
+      );
+    }
+    this.emitJoined();
+  }
+
+  /** Every EMG sample whose AUX sample came, joined. */
+  private emitJoined(): void {
+    const { values, n } = this.join!.drain();
+    this.counts.aux.held = this.join!.counts.held;
+    this.counts.aux.dropped = this.join!.counts.dropped;
+    if (n > 0) this.ev.samples(values, n);
   }
 
   /** Drops the connections (STOP first when asked and possible). */
@@ -183,8 +240,11 @@ export class TrignoLink {
     if (this.cmd && this.cmdOpen && stop && wasStarted) this.cmd.write(`STOP${TRIGNO_TERMINATOR}`);
     this.cmd?.close();
     this.data?.close();
+    this.auxSock?.close();
     this.cmd = undefined;
     this.data = undefined;
+    this.auxSock = undefined;
+    this.auxParser?.reset();
     this.cmdOpen = false;
     this.replies.length = 0;
     this.text = "";
@@ -320,7 +380,9 @@ export class TrignoLink {
     await this.expectOk(gen, "UPSAMPLE OFF", true);
     await this.querySensors(gen);
     await this.queryRate(gen);
+    await this.queryAux(gen);
     await this.connectData(gen);
+    await this.connectAux(gen);
     this.started = true; // data may come before START's reply
     await this.expectOk(gen, "START");
     this.streaming();
@@ -341,6 +403,7 @@ export class TrignoLink {
     // Unpaired slots carry zeros: anything else there means a misaligned stream.
     const all = new Set<number>(unpaired);
     this.parser.setUnpaired(all);
+    this.auxParser?.setUnpaired(all);
     if (unpaired.length > 0 && unpaired.join(",") !== before) {
       this.ev.warn(
         `${this.target}: sensor${unpaired.length > 1 ? "s" : ""} ${unpaired.join(", ")} not paired: ${unpaired.length > 1 ? "their channels stay" : "its channel stays"} 0 (pair them in the Trigno Control Utility)`,
@@ -361,25 +424,71 @@ export class TrignoLink {
     this.counts.rate = rate;
   }
 
+  /** The AUX samples per frame (when the AUX port is used); the join starts again. */
+  private async queryAux(gen: number): Promise<void> {
+    if (!this.join) return;
+    const auxPerFrame = (await this.number(gen, "MAX SAMPLES AUX?")) ?? TRIGNO_AUX_SAMPLES;
+    const emgPerFrame = Math.round(this.counts.rate * TRIGNO_FRAME_INTERVAL);
+    this.counts.aux.perFrame = auxPerFrame;
+    this.join.restart(emgPerFrame, auxPerFrame);
+  }
+
   private connectData(gen: number): Promise<void> {
+    return this.connectPort(
+      gen,
+      "EMG",
+      this.o.emgPort,
+      (d) => this.onData(gen, d),
+      (h) => {
+        this.data = h;
+      },
+    );
+  }
+
+  private async connectAux(gen: number): Promise<void> {
+    if (!this.join) return;
+    const port = this.o.auxPort ?? TRIGNO_AUX_PORT;
+    await this.connectPort(
+      gen,
+      "AUX",
+      port,
+      (d) => this.onAuxData(gen, d),
+      (h) => {
+        this.auxSock = h;
+      },
+    );
+  }
+
+  /**
+   * Connects a data port (`keep` gets the handle at once, so a teardown meanwhile closes it);
+   * resolves once connected, fails the link if it ends later.
+   */
+  private connectPort(
+    gen: number,
+    what: string,
+    port: number,
+    onData: (d: Uint8Array) => void,
+    keep: (h: TcpSocketHandle) => void,
+  ): Promise<void> {
     return new Promise((resolve, reject) => {
-      this.data = this.tcp.connect(
-        { host: this.o.host, port: this.o.emgPort },
+      const h = this.tcp.connect(
+        { host: this.o.host, port },
         {
           onConnect: () => {
             if (gen === this.gen) resolve();
           },
-          onData: (d) => this.onData(gen, d),
+          onData,
           onClose: (reason, wasOpen) => {
             const why = wasOpen
-              ? `the EMG data connection (port ${this.o.emgPort}) ended: ${reason}`
-              : `EMG data port: ${reason}`;
+              ? `the ${what} data connection (port ${port}) ended: ${reason}`
+              : `${what} data port: ${reason}`;
             if (!wasOpen) reject(new Error(why));
             else this.fail(gen, why);
           },
         },
         { timeoutMs: REPLY_TIMEOUT * 1000 },
       );
+      keep(h);
     });
   }
 
@@ -390,9 +499,11 @@ export class TrignoLink {
     const attempts = this.counts.failures;
     this.counts.failures = 0;
     const n = this.o.sensors.length;
+    const aux = this.o.aux ?? 0;
+    const withAux = aux === 0 ? "" : ` with ${aux === 3 ? "accelerometers" : "IMUs"} (AUX)`;
     this.ev.state(
       "streaming",
-      `streaming ${n} sensor${n === 1 ? "" : "s"} at ${hzText(this.counts.rate)} from ${this.target}`,
+      `streaming ${n} sensor${n === 1 ? "" : "s"}${withAux} at ${hzText(this.counts.rate)} from ${this.target}`,
     );
     if (reconnected) {
       this.ev.warn(
@@ -417,7 +528,7 @@ export function delsysProtocol(
         sink.warn(noTcpMessage(target));
         return undefined;
       }
-      const k = o.sensors.length;
+      const k = trignoWidth(o);
       const link = new TrignoLink(ctx, tcp, o, {
         samples(values, n) {
           for (let i = 0; i < n; i++) sink.push(values, i * k);

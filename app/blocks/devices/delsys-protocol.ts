@@ -28,16 +28,54 @@ export const TRIGNO_NATIVE_RATE = TRIGNO_NATIVE_SAMPLES / TRIGNO_FRAME_INTERVAL;
  * widest mode), so a misaligned stream's garbage floats show up here.
  */
 export const TRIGNO_MAX_VOLTS = 0.1;
+/** The TCU's Avanti AUX (IMU) data port (legacy sensors' accelerometers: 50042). */
+export const TRIGNO_AUX_PORT = 50044;
+/** Values per sensor slot on the AUX port: accelerometer, gyroscope, magnetometer x, y, z. */
+export const TRIGNO_AUX_PER_SLOT = 9;
+/** AUX samples per frame (148.148 Hz). */
+export const TRIGNO_AUX_SAMPLES = 2;
+/**
+ * Beyond this magnitude a value cannot be an IMU reading (accelerometers span ±16 g, gyroscopes
+ * ±2000 °/s, magnetometers about ±4900 µT): a misaligned AUX stream's garbage shows up here.
+ */
+export const TRIGNO_MAX_AUX = 1e5;
 /** Command terminator (commands and replies). */
 export const TRIGNO_TERMINATOR = "\r\n\r\n";
 
 /** Hz with three decimals, as the TCU's rates are written: "1925.926 Hz". */
 export const hzText = (hz: number): string => `${(Math.round(hz * 1000) / 1000).toFixed(3)} Hz`;
 
+/**
+ * Below this magnitude a non-zero value is no reading either (a sensor's quantised values are
+ * far larger): a stream misaligned by 1–3 bytes makes such tiny floats from its bytes.
+ */
+const TINY = 1e-30;
 /** Whole samples needed after a candidate alignment before it is trusted. */
 const RESYNC_SAMPLES = 3;
 /** Bytes kept while searching for the alignment before a sample's worth is given up. */
-const RESYNC_WINDOW = TRIGNO_SAMPLE_BYTES * 32;
+const RESYNC_WINDOW_SAMPLES = 32;
+
+/** What a data port carries per sample: values per sensor slot and their plausible range. */
+export interface TrignoStreamKind {
+  /** "EMG" or "AUX", for messages. */
+  name: string;
+  perSlot: number;
+  maxAbs: number;
+  unit: string;
+}
+
+export const TRIGNO_EMG: TrignoStreamKind = {
+  name: "EMG",
+  perSlot: 1,
+  maxAbs: TRIGNO_MAX_VOLTS,
+  unit: " V",
+};
+export const TRIGNO_AUX: TrignoStreamKind = {
+  name: "AUX",
+  perSlot: TRIGNO_AUX_PER_SLOT,
+  maxAbs: TRIGNO_MAX_AUX,
+  unit: "",
+};
 
 /**
  * Splits the EMG port's byte stream into samples of 16 values. `onSample(values)` gets each
@@ -47,11 +85,14 @@ const RESYNC_WINDOW = TRIGNO_SAMPLE_BYTES * 32;
  * seen in the values and goes undetected (docs/protocols.md).
  */
 export class TrignoEmgParser {
-  private buf = new Uint8Array(TRIGNO_SAMPLE_BYTES * 64);
-  private view = new DataView(this.buf.buffer);
+  /** Bytes of one sample: 16 slots × values per slot × float32. */
+  readonly sampleBytes: number;
+  private readonly perSample: number;
+  private buf: Uint8Array;
+  private view: DataView;
   private len = 0;
   private inBadRun = false;
-  private readonly values = new Float64Array(TRIGNO_SENSORS);
+  private readonly values: Float64Array;
   /** Slots (0-based) that must carry exactly 0: the unpaired sensors, when known. */
   private zero = new Uint8Array(TRIGNO_SENSORS);
   samples = 0;
@@ -60,7 +101,16 @@ export class TrignoEmgParser {
   /** Why the last malformed sample was refused. */
   lastProblem = "";
 
-  constructor(private readonly onSample: (values: Float64Array) => void) {}
+  constructor(
+    private readonly onSample: (values: Float64Array) => void,
+    private readonly kind: TrignoStreamKind = TRIGNO_EMG,
+  ) {
+    this.perSample = TRIGNO_SENSORS * kind.perSlot;
+    this.sampleBytes = this.perSample * 4;
+    this.values = new Float64Array(this.perSample);
+    this.buf = new Uint8Array(this.sampleBytes * 64);
+    this.view = new DataView(this.buf.buffer);
+  }
 
   /** Marks the slots of unpaired sensors (1-based numbers): their values must be 0. */
   setUnpaired(sensors: Iterable<number>): void {
@@ -70,18 +120,23 @@ export class TrignoEmgParser {
 
   /** Why the sample at byte `at` is implausible; undefined when it is plausible. */
   private problem(at: number): string | undefined {
-    for (let s = 0; s < TRIGNO_SENSORS; s++) {
-      const v = this.view.getFloat32(at + 4 * s, true);
-      if (!Number.isFinite(v)) return `sensor ${s + 1}: ${v}`;
-      if (Math.abs(v) > TRIGNO_MAX_VOLTS) return `sensor ${s + 1}: ${v.toPrecision(3)} V`;
-      if (this.zero[s] === 1 && v !== 0) return `unpaired sensor ${s + 1}: ${v.toPrecision(3)} V`;
+    const { perSlot, maxAbs, unit } = this.kind;
+    for (let i = 0; i < this.perSample; i++) {
+      const v = this.view.getFloat32(at + 4 * i, true);
+      const s = Math.floor(i / perSlot);
+      const where =
+        perSlot === 1 ? `sensor ${s + 1}` : `sensor ${s + 1} value ${(i % perSlot) + 1}`;
+      if (!Number.isFinite(v)) return `${where}: ${v}`;
+      const m = Math.abs(v);
+      if (m > maxAbs || (m < TINY && m !== 0)) return `${where}: ${v.toPrecision(3)}${unit}`;
+      if (this.zero[s] === 1 && v !== 0) return `unpaired ${where}: ${v.toPrecision(3)}${unit}`;
     }
     return undefined;
   }
 
   private plausibleRun(at: number): boolean {
     for (let i = 0; i < RESYNC_SAMPLES; i++) {
-      if (this.problem(at + i * TRIGNO_SAMPLE_BYTES) !== undefined) return false;
+      if (this.problem(at + i * this.sampleBytes) !== undefined) return false;
     }
     return true;
   }
@@ -102,14 +157,14 @@ export class TrignoEmgParser {
   feed(chunk: Uint8Array): number {
     this.append(chunk);
     const before = this.samples;
-    const B = TRIGNO_SAMPLE_BYTES;
+    const B = this.sampleBytes;
     let pos = 0;
     while (this.len - pos >= B) {
       const why = this.problem(pos);
       if (why === undefined) {
         this.inBadRun = false;
-        for (let s = 0; s < TRIGNO_SENSORS; s++) {
-          this.values[s] = this.view.getFloat32(pos + 4 * s, true);
+        for (let i = 0; i < this.perSample; i++) {
+          this.values[i] = this.view.getFloat32(pos + 4 * i, true);
         }
         this.samples++;
         this.onSample(this.values);
@@ -134,9 +189,10 @@ export class TrignoEmgParser {
       if (shift === 0) shift = B; // nothing fits here: give this sample up
       this.skippedBytes += shift;
       pos += shift;
-      if (this.len - pos > RESYNC_WINDOW) {
+      const keep = RESYNC_WINDOW_SAMPLES * B;
+      if (this.len - pos > keep) {
         // Garbage for a while: drop all but the last window.
-        const drop = this.len - pos - RESYNC_WINDOW;
+        const drop = this.len - pos - keep;
         this.skippedBytes += drop;
         pos += drop;
       }

@@ -4,13 +4,14 @@ import { plural, TextThrottle } from "../shared/text";
 import {
   DeviceClock,
   hzText,
+  TRIGNO_AUX_PORT,
   TRIGNO_COMMAND_PORT,
   TRIGNO_EMG_PORT,
   TRIGNO_NATIVE_RATE,
   TRIGNO_NATIVE_SAMPLES,
   TRIGNO_SENSORS,
 } from "./delsys-protocol";
-import { delsysProtocol, TrignoLink, type TrignoLinkOptions } from "./delsys-link";
+import { delsysProtocol, TrignoLink, trignoWidth, type TrignoLinkOptions } from "./delsys-link";
 import { noTcpMessage } from "./stream-link";
 import { pacedDevice, pacingTimer } from "./paced-device";
 
@@ -56,7 +57,38 @@ const params = z.strictObject({
     .max(65535)
     .optional()
     .describe(`The TCU's Avanti EMG data port (default ${TRIGNO_EMG_PORT})`),
+  Aux: z
+    .enum(["none", "acc", "imu"])
+    .default("none")
+    .describe(
+      "IMU channels joined after each sensor's EMG channel, from the TCU's AUX port at 148.148 " +
+        "Hz, each value held for the 13 EMG samples it spans: none; acc (accelerometer x, y, z " +
+        "in g: 4 channels per sensor, the paper's 8 sensors × 4 = 32); imu (accelerometer, " +
+        "gyroscope in °/s, magnetometer in µT: 10 per sensor)",
+    ),
+  AuxPort: z
+    .number()
+    .int()
+    .min(1)
+    .max(65535)
+    .optional()
+    .describe(`The TCU's Avanti AUX (IMU) data port (default ${TRIGNO_AUX_PORT})`),
 });
+
+/** AUX values per sensor for each `Aux` choice. */
+const AUX_VALUES = { none: 0, acc: 3, imu: 9 } as const;
+const AUX_NAMES = [
+  "acc x",
+  "acc y",
+  "acc z",
+  "gyro x",
+  "gyro y",
+  "gyro z",
+  "mag x",
+  "mag y",
+  "mag z",
+];
+const AUX_UNITS = ["g", "g", "g", "°/s", "°/s", "°/s", "µT", "µT", "µT"];
 
 type Params = z.output<typeof params>;
 
@@ -65,9 +97,15 @@ export function selectedSensors(s: Params["Sensors"]): number[] {
   return typeof s === "number" ? Array.from({ length: s }, (_, i) => i + 1) : [...s];
 }
 
-/** "sensor 3" per channel, for the `channels` action. */
-const channelNames = (sensors: readonly number[]): string[] =>
-  sensors.map((s, i) => `channel ${i + 1}: sensor ${s} (EMG, V)`);
+/** What each output channel carries, for the `channels` action. */
+function channelNames(sensors: readonly number[], aux: number): string[] {
+  const names: string[] = [];
+  for (const s of sensors) {
+    names.push(`sensor ${s} (EMG, V)`);
+    for (let j = 0; j < aux; j++) names.push(`sensor ${s} (${AUX_NAMES[j]}, ${AUX_UNITS[j]})`);
+  }
+  return names.map((n, i) => `channel ${i + 1}: ${n}`);
+}
 
 export const Delsys = defineBlock({
   type: "Delsys",
@@ -81,7 +119,10 @@ export const Delsys = defineBlock({
     "TCU's backwards compatibility and upsampling off, asks which of the selected `Sensors` are " +
     "paired (an unpaired one is reported and its channel stays 0), sends START and parses the " +
     "float32 stream (16 sensor slots per sample, volts), one channel per selected sensor in the " +
-    "order listed. **Without an input** it is its own source at the device's rate (" +
+    "order listed. With `Aux: acc` (or `imu`) it also reads the AUX port (IMU, 148.148 Hz) and " +
+    "joins each sensor's accelerometer (or all nine IMU values) after its EMG channel, each AUX " +
+    "sample held for the 13 EMG samples of its half frame: 8 sensors give the paper's 32 " +
+    "channels. **Without an input** it is its own source at the device's rate (" +
     `${hzText(TRIGNO_NATIVE_RATE)}, ${TRIGNO_NATIVE_SAMPLES} samples every 13.5 ms): what arrives ` +
     "is emitted at once as one frame, stamped on the device's sample clock (the first batch's " +
     "last sample at its arrival, then 1 / rate apart, at most one 13.5 ms frame ahead of " +
@@ -111,20 +152,17 @@ export const Delsys = defineBlock({
       commandPort: p.Port ?? TRIGNO_COMMAND_PORT,
       emgPort: p.EmgPort ?? TRIGNO_EMG_PORT,
       sensors,
+      aux: AUX_VALUES[p.Aux],
+      auxPort: p.AuxPort ?? TRIGNO_AUX_PORT,
     };
-    if (p.Port !== undefined && p.EmgPort === p.Port) {
-      throw new BlockConfigError(
-        `EmgPort ${p.EmgPort} is the command Port too: the TCU serves them on different ports`,
-        "EmgPort",
-      );
-    }
+    checkPorts(p, link);
     const target = `the Trigno Control Utility at ${p.Host}:${link.commandPort}`;
     let current: TrignoLink | undefined;
     const actions = {
       channels: {
         label: "Channels",
         description: "Which sensor each output channel carries",
-        run: () => channelNames(sensors).join("; "),
+        run: () => channelNames(sensors, link.aux ?? 0).join("; "),
       },
       counts: {
         label: "Counts",
@@ -137,7 +175,7 @@ export const Delsys = defineBlock({
       const instance = pacedDevice(ctx, {
         device: "Delsys Trigno",
         target: `${target} (Trigno SDK, TCP)`,
-        shape: vectorShape(sensors.length),
+        shape: vectorShape(trignoWidth(link)),
         port: "emg",
         // Two TCU frames: a 1926 Hz timer drains each 13.5 ms frame before the next comes.
         maxQueue: 2 * (TRIGNO_NATIVE_SAMPLES + 1),
@@ -149,6 +187,26 @@ export const Delsys = defineBlock({
   },
 });
 
+/** The command, EMG and AUX ports must differ (the TCU serves each kind on its own port). */
+function checkPorts(p: Params, link: TrignoLinkOptions): void {
+  const used: [string, number][] = [
+    ["Port", link.commandPort],
+    ["EmgPort", link.emgPort],
+  ];
+  if ((link.aux ?? 0) > 0) used.push(["AuxPort", link.auxPort ?? TRIGNO_AUX_PORT]);
+  for (let i = 0; i < used.length; i++) {
+    for (let j = 0; j < i; j++) {
+      if (used[i]![1] !== used[j]![1]) continue;
+      const [a, b] = [used[j]!, used[i]!];
+      const key = p[b[0] as keyof Params] !== undefined ? b[0] : a[0];
+      throw new BlockConfigError(
+        `${b[0]} ${b[1]} is the ${a[0]} too: the TCU serves commands, EMG and AUX data on different ports`,
+        key,
+      );
+    }
+  }
+}
+
 /** One line of counts, for the action. */
 function countsText(link: TrignoLink | undefined): string {
   if (!link) return "not started";
@@ -158,6 +216,9 @@ function countsText(link: TrignoLink | undefined): string {
     `${c.malformed} malformed (${c.skippedBytes} bytes skipped${c.lastProblem ? `, last: ${c.lastProblem}` : ""}), ` +
     `${c.truncated} truncated (${c.truncatedBytes} bytes)` +
     (c.unpaired.length > 0 ? `, not paired: ${c.unpaired.join(", ")}` : "") +
+    ((link.options.aux ?? 0) > 0
+      ? `; AUX: ${c.aux.samples} samples, ${c.aux.malformed} malformed, ${c.aux.held} EMG samples with held AUX values, ${c.aux.dropped} AUX samples dropped`
+      : "") +
     (c.banner ? `; TCU: ${c.banner}` : "")
   );
 }
@@ -170,7 +231,7 @@ function nativeSource(
   onLink: (l: TrignoLink) => void,
 ) {
   if (ctx.declaredRate === undefined) ctx.setDesiredRate(TRIGNO_NATIVE_RATE);
-  const k = o.sensors.length;
+  const k = trignoWidth(o);
   const out = ctx.output(vectorShape(k), "emg");
   const clock = new DeviceClock(TRIGNO_NATIVE_RATE);
   const throttle = new TextThrottle(0.5);
@@ -188,6 +249,8 @@ function nativeSource(
       if (clock.gapSamples > 0) text += ` · ${clock.gapSamples} samples lost in gaps`;
       if (c.malformed > 0) text += ` · ${c.malformed} malformed (${c.skippedBytes} bytes skipped)`;
       if (c.truncated > 0) text += ` · ${c.truncated} truncated`;
+      if (c.aux.malformed > 0) text += ` · ${c.aux.malformed} malformed AUX`;
+      if (c.aux.held > 0) text += ` · ${c.aux.held} samples with held AUX`;
       if (clock.reanchors > 0) text += ` · re-anchored ${clock.reanchors}×`;
     }
     if (text !== lastText) {

@@ -64,6 +64,7 @@ describe("the original's device types load with their positional forms", () => {
     expect(load("d: { Type: Delsys, Inputs: [t] }").params).toEqual({
       Sensors: 16,
       Host: "127.0.0.1",
+      Aux: "none",
     });
     expect(load("a: { Type: DLR_ADCBT, Inputs: [t], Params: [ COM5, 8 ] }").params).toEqual({
       Port: "COM5",

@@ -265,10 +265,13 @@ export const SIMULATED_DEVICES: Readonly<Record<string, DeviceRule>> = {
     kind: "source",
     network: false,
     becomes:
-      "EmgSimulator with one channel per sensor on its timer (without one, a new ScheduledTimer at the Trigno's native 1925.926 Hz)",
+      "EmgSimulator with one channel per sensor (plus its AUX channels) on its timer (without one, a new ScheduledTimer at the Trigno's native 1925.926 Hz)",
     substitute(b, env) {
       const sensors = p(b).Sensors as number | number[];
-      const channels = Array.isArray(sensors) ? sensors.length : sensors;
+      const aux = { none: 0, acc: 3, imu: 9 }[
+        (p(b).Aux as "none" | "acc" | "imu" | undefined) ?? "none"
+      ];
+      const channels = (Array.isArray(sensors) ? sensors.length : sensors) * (1 + aux);
       if (timerOf(b)) return emgOnTimer(b, env, channels);
       const clock = env.freshName(`${b.name}_clock`);
       return {
