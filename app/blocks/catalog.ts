@@ -10,6 +10,7 @@ import { ImuSimulator } from "./devices/imu-simulator";
 import { Muovi } from "./devices/muovi";
 import { MuoviSingleProbe } from "./devices/muovi-single-probe";
 import { NilsPod } from "./devices/nilspod";
+import { Quattrocento } from "./devices/quattrocento";
 import { SimulatedOutput } from "./devices/simulated-output";
 import { FeatureSet } from "./features/feature-set";
 import { IntegratedAbsoluteValue } from "./features/integrated-absolute-value";
@@ -144,6 +145,7 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   // Devices (app/blocks/devices/)
   Muovi,
   MuoviSingleProbe,
+  Quattrocento,
   Delsys,
   DLR_ADCBT,
   NilsPod,

@@ -19,6 +19,10 @@ import {
   SyncStationSimulator,
   syncStationSimulatorOptions,
 } from "../devices/muovi-simulator";
+import {
+  QuattrocentoSimulator,
+  quattrocentoSimulatorOptions,
+} from "../devices/quattrocento-simulator";
 
 type OptionSpec = { type: "string" | "boolean"; default?: string | boolean };
 type Values = Record<string, string | boolean | undefined>;
@@ -179,6 +183,30 @@ export const SIMULATORS: Record<string, DeviceSimulator> = {
         lines: [
           `Muovi probe simulator connecting to ${o.host}:${o.port} (again every 0.5 s while not connected), seed ${sim.seed}`,
           "Ctrl-C stops it.",
+        ],
+        close: () => sim.close(),
+      };
+    },
+  },
+  quattrocento: {
+    summary:
+      "OT Bioelettronica Quattrocento (TCP server, 23456): after a 40-byte command with a good CRC-8 streams 120–408 int16 LE channels at 512–10240 Hz",
+    usage: "[--host ADDR] [--port P] [--seed S] [--verbose]",
+    options: {
+      host: { type: "string" },
+      port: { type: "string" },
+      seed: { type: "string" },
+      verbose: { type: "boolean", default: false },
+    },
+    async start(v, log) {
+      const sim = await QuattrocentoSimulator.start({
+        ...quattrocentoSimulatorOptions(v),
+        ...(v.verbose ? { log } : {}),
+      });
+      return {
+        lines: [
+          `Quattrocento simulator listening on ${sim.host}:${sim.port}: waits for a configuration command (40 bytes, CRC-8), then streams the commanded channels (120, 216, 312 or 408) at the commanded rate (512…10240 Hz), seed ${sim.seed}`,
+          "Point Quattrocento's Host and Port there. Ctrl-C stops it.",
         ],
         close: () => sim.close(),
       };

@@ -261,6 +261,20 @@ export const SIMULATED_DEVICES: Readonly<Record<string, DeviceRule>> = {
       };
     },
   },
+  Quattrocento: {
+    kind: "source",
+    network: false,
+    becomes:
+      "EmgSimulator with its output channels (Select, or the listed Connectors' 16 or 64 each) on a new ScheduledTimer at its Rate",
+    substitute: (b, env) => {
+      const q = p(b);
+      const select = q.Select as number[] | undefined;
+      const connectors = q.Connectors as string[];
+      const channels =
+        select?.length ?? connectors.reduce((n, c) => n + (c.startsWith("MULTIPLE") ? 64 : 16), 0);
+      return emgAtRate(b, env, channels, q.Rate as number);
+    },
+  },
   Delsys: {
     kind: "source",
     network: false,
