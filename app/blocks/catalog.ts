@@ -57,6 +57,7 @@ import { LslMarkerInlet } from "./lsl/lsl-marker-inlet";
 import { LslMarkers } from "./lsl/lsl-markers";
 import { LslOutlet } from "./lsl/lsl-outlet";
 import { Logger } from "./recording/logger";
+import { XdfRecorder } from "./recording/xdf-recorder";
 import { AdaptiveFilter } from "./signal/adaptive-filter";
 import { DoubleDifferential } from "./signal/dds";
 import { PythonNetFiltUC } from "./signal/python-net-filt-uc";
@@ -153,6 +154,7 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   SimulatedOutput,
   // Recording
   Logger,
+  XdfRecorder,
   // Testing
   Sink,
   Busy,

@@ -6,6 +6,7 @@
  *   mosaic run FILE [options]          live per-block table (or --json lines); Ctrl-C stops cleanly
  *   mosaic bench [options]             the standard performance suite (see `mosaic bench --help`)
  *   mosaic simulate DEVICE [options]   a device simulator (app/devices/) until Ctrl-C
+ *   mosaic repair FILE...              makes an interrupted recording (XDF) whole again
  */
 import { readFileSync, statSync, writeFileSync } from "node:fs";
 import { dirname, join, resolve } from "node:path";
@@ -17,6 +18,7 @@ import type { Telemetry } from "../engine/runtime/runtime";
 import { Host, webRoot } from "../host/host";
 import { serveStatic } from "../host/web-server";
 import { runBench } from "./bench";
+import { cmdRepair, repairHelp } from "./repair";
 import { cmdSimulate, simulateHelp } from "./simulate";
 import { renderTable } from "./table";
 
@@ -79,6 +81,7 @@ Usage:
       Runs a device's simulator on this machine, written from its protocol, so that a pipeline
       can be demonstrated without the hardware; prints where it listens, runs until Ctrl-C.
 ${simulateHelp()}
+${repairHelp()}
   mosaic --help | --version
 `;
 
@@ -582,9 +585,11 @@ async function dispatch(cmd: string | undefined, rest: string[]): Promise<number
       return cmdServe(rest);
     case "simulate":
       return cmdSimulate(rest, out, err);
+    case "repair":
+      return cmdRepair(rest, out, err);
     default:
       err(
-        `mosaic: unknown command '${cmd}' (commands: validate, format, run, web, serve, bench, simulate; see mosaic --help)`,
+        `mosaic: unknown command '${cmd}' (commands: validate, format, run, web, serve, bench, simulate, repair; see mosaic --help)`,
       );
       return 2;
   }
