@@ -4,6 +4,7 @@
  */
 import { createCatalog, type AnyBlockDefinition } from "../engine";
 import { Dasdv } from "./features/dasdv";
+import { BrainFlow } from "./devices/brainflow";
 import { Delsys } from "./devices/delsys";
 import { DLR_ADCBT } from "./devices/dlr-adcbt";
 import { ImuSimulator } from "./devices/imu-simulator";
@@ -150,6 +151,7 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   Delsys,
   DLR_ADCBT,
   NilsPod,
+  BrainFlow,
   ImuSimulator,
   SimulatedOutput,
   // Recording

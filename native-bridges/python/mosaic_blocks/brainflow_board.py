@@ -23,7 +23,8 @@ with a message that says what to check; later attempts failing the same way are 
 
 Params (JSON from the block): board (name or number), library (brainflow | mindrove | auto),
 input (BrainFlowInputParams fields), master_board (for the playback and streaming boards),
-channels (kinds: exg, emg, eeg, ecg, eog, accel, gyro, magnetometer, package), poll_rate (Hz: the
+channels (kinds: exg, emg, eeg, ecg, eog, accel, gyro, magnetometer, package,
+timestamp), poll_rate (Hz: the
 result holds up to 4 polls' samples, at least 32; or max_rows), silence (s;
 0: never), buffer (BrainFlow's ring buffer, samples), log_level (BrainFlow's logger: 0 trace … 6
 off), retry (a fixed wait between attempts, s, instead of the backoff; tests).
@@ -64,6 +65,7 @@ KINDS = {
     "gyro": "get_gyro_channels",
     "magnetometer": "get_magnetometer_channels",
     "package": "get_package_num_channel",
+    "timestamp": "get_timestamp_channel",
 }
 
 INPUT_FIELDS = (
@@ -232,7 +234,11 @@ class Reader:
         self.buffer = int(params.get("buffer", 450000))
         self.retry_fixed = float(params.get("retry", 0) or 0)
         self.log_level = int(params.get("log_level", 6))
-        self.target = f"{self.lib} board {board}"
+        where = next(
+            (str(v) for k in ("serial_port", "ip_address", "mac_address", "file") if (v := getattr(self.inputs, k, ""))),
+            "",
+        )
+        self.target = f"{self.lib} board {board}" + (f" on {where}" if where else "")
         self.queue: collections.deque[np.ndarray] = collections.deque()
         self.lock = threading.Lock()
         self.state = IDLE
