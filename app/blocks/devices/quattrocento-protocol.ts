@@ -174,6 +174,9 @@ export function quattrocentoCommand(c: QuattrocentoConfig, acquire: boolean): Ui
   return cmd;
 }
 
+/** Whether this machine stores an int16 little-endian, as the wire does (then samples are copied). */
+const LITTLE_ENDIAN = new Uint8Array(Uint16Array.of(1).buffer)[0] === 1;
+
 /** Whole samples in a row whose counters follow each other before an alignment is trusted. */
 export const LOCK_SAMPLES = 3;
 /** The largest jump of the counter taken for samples the device skipped (1 s at 10240 Hz). */
@@ -192,6 +195,8 @@ export class QuattrocentoStreamParser {
   readonly sampleBytes: number;
   private readonly counterAt: number;
   private buf: Uint8Array;
+  /** `buf` as int16 (its byte length is even): a sample at an even offset is copied from it. */
+  private words: Int16Array;
   private len = 0;
   private expected = -1;
   private inBadRun = false;
@@ -216,6 +221,7 @@ export class QuattrocentoStreamParser {
     this.counterAt = 2 * counterChannel(channels);
     this.raw = new Int16Array(channels);
     this.buf = new Uint8Array(this.sampleBytes * 64);
+    this.words = new Int16Array(this.buf.buffer);
   }
 
   /** Bytes held (part of a sample, or a search for the alignment). */
@@ -238,6 +244,7 @@ export class QuattrocentoStreamParser {
       const bigger = new Uint8Array(size);
       bigger.set(this.buf.subarray(0, this.len));
       this.buf = bigger;
+      this.words = new Int16Array(bigger.buffer);
     }
     this.buf.set(chunk, this.len);
     this.len += chunk.length;
@@ -347,7 +354,10 @@ export class QuattrocentoStreamParser {
         }
       }
       const raw = this.raw;
-      for (let ch = 0, i = at; ch < raw.length; ch++, i += 2) raw[ch] = b[i]! | (b[i + 1]! << 8);
+      if (LITTLE_ENDIAN && (at & 1) === 0)
+        raw.set(this.words.subarray(at >> 1, (at >> 1) + raw.length));
+      else
+        for (let ch = 0, i = at; ch < raw.length; ch++, i += 2) raw[ch] = b[i]! | (b[i + 1]! << 8);
       this.expected = (c + 1) & 0xffff;
       this.samples++;
       at += S;
