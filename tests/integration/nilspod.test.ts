@@ -5,8 +5,24 @@
  * counter gaps, malformed notifications, lost links and reconnection, the stop command, and the
  * engine worker's relay (native-bridges/ble-proxy.ts). Runs on the harness's virtual clock.
  */
-import { describe, expect, test } from "vitest";
-import { EMPTY_SHAPE, Frame, type BleBridge } from "../../app/engine";
+import { readFileSync } from "node:fs";
+import { join } from "node:path";
+import { beforeAll, describe, expect, test } from "vitest";
+import {
+  createCatalog,
+  EMPTY_SHAPE,
+  formatDiagnostic,
+  Frame,
+  loadPipeline,
+  Runtime,
+  VirtualClock,
+  type BleBridge,
+} from "../../app/engine";
+import { withSimulatedDevices } from "../../app/engine/pipeline/simulate";
+import { runVirtual } from "../../app/engine/runtime/virtual";
+import { noResources } from "../../app/engine/testing";
+import { BLOCKS } from "../../app/blocks/catalog";
+import { initDspForTests } from "../support/wasm";
 import { BlockHarness } from "../../app/engine/testing";
 import { bleHub, bleProxy, type BleReply, type BleRequest } from "../../native-bridges/ble-proxy";
 import { NilsPodSimulator, nilsPodSimRaw } from "../../app/devices/nilspod-simulator";
@@ -270,6 +286,9 @@ describe("NilsPod block on a simulated NilsPod", () => {
     const { h, device } = await setUp({ Address: ADDRESS }, { adapter: "unavailable" });
     h.start();
     expect(h.text).toMatch(/^no Bluetooth adapter \(sending zeros\)/);
+    expect(h.warnings).toEqual([
+      "NilsPod: no Bluetooth adapter: the NilsPod d4:22:cd:00:4e:01 over Bluetooth LE cannot be reached, the block sends zeros (without the device: mosaic run --simulate-devices)",
+    ]);
     device.setAdapter("poweredOn");
     await settle();
     expect(h.text).toBe(`streaming from ${WHO}`);
@@ -309,5 +328,47 @@ describe("NilsPod block on a simulated NilsPod", () => {
     expect(device.writes.at(-1)).toBe(`${COMMANDS} c1`);
     expect(device.isConnected).toBe(false);
     hub!.closeAll();
+  });
+});
+
+describe("pipelines/devices/nilspod.yaml", () => {
+  beforeAll(() => initDspForTests());
+  const catalog = createCatalog(BLOCKS);
+  const file = join(__dirname, "../../pipelines/devices/nilspod.yaml");
+  const yaml = readFileSync(file, "utf8");
+
+  test("loads as written, and under --simulate-devices runs with an ImuSimulator in its place", async () => {
+    const real = loadPipeline(yaml, file, catalog);
+    expect(real.diagnostics.filter((d) => d.severity === "error").map(formatDiagnostic)).toEqual(
+      [],
+    );
+    expect(real.spec!.blocks.find((b) => b.name === "Imu")!.type).toBe("NilsPod");
+    const sim = withSimulatedDevices(loadPipeline(yaml, file, catalog), catalog, {});
+    expect(sim.diagnostics.map((d) => d.message)).toContain(
+      "block 'Imu' (NilsPod) simulated by ImuSimulator, 6 values at 102.4 Hz (its timer's)",
+    );
+    const clock = new VirtualClock(0);
+    const created = await Runtime.create({
+      spec: sim.spec!,
+      catalog,
+      clock,
+      virtual: true,
+      resources: noResources,
+      ignorePlacement: true,
+    });
+    expect(created.diagnostics.filter((d) => d.severity === "error").map(formatDiagnostic)).toEqual(
+      [],
+    );
+    const rt = created.runtime!;
+    const imu: number[][] = [];
+    rt.tap("Imu", undefined, (f) => {
+      for (let i = 0; i < f.n; i++) imu.push(Array.from(f.v.subarray(i * 6, i * 6 + 6)));
+    });
+    rt.start();
+    runVirtual(rt, clock, 2);
+    rt.dispose();
+    // 2 s at 102.4 Hz; gravity (≈ 9.8 m/s²) on the simulated forearm's y–z plane.
+    expect(Math.abs(imu.length - 205)).toBeLessThanOrEqual(1);
+    expect(Math.hypot(imu[0]![1]!, imu[0]![2]!)).toBeGreaterThan(9);
   });
 });

@@ -94,6 +94,7 @@ export class NilsPodLink {
   private phase: Phase = "adapter";
   private adapter: BleAdapterState = "unknown";
   private adapterMessage = "";
+  private warnedAdapter = false;
   private watch: { close(): void } | undefined;
   private scan: { stop(): void } | undefined;
   private scanSince = 0;
@@ -152,6 +153,13 @@ export class NilsPodLink {
     if (s === "poweredOn") {
       if (this.phase === "adapter") this.beginScan();
       return;
+    }
+    if (s !== "unknown" && s !== "resetting" && !this.warnedAdapter) {
+      this.warnedAdapter = true;
+      this.sink.warn(
+        `${this.adapterMessage || ADAPTER_TEXT[s]}: ${this.o.target} cannot be reached, the block ` +
+          "sends zeros (without the device: mosaic run --simulate-devices)",
+      );
     }
     // The adapter went away: the link (if any) went with it.
     if (this.phase === "streaming") this.counts.disconnections++;
