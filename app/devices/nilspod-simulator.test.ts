@@ -63,4 +63,25 @@ describe("NilsPod simulator", () => {
     expect(lost).toEqual(["out of range"]);
     await expect(c.write(SERVICE, COMMANDS, Uint8Array.of(0xc2))).rejects.toThrow(/disconnected/);
   });
+
+  test("realtime: notifications on the wall clock at the device's rate, never ahead of it", async () => {
+    const t0 = performance.now() / 1000;
+    const sim = new NilsPodSimulator({ realtime: true, rate: 204.8 });
+    try {
+      const c = await sim.connect(sim.address, () => {});
+      const got: number[] = [];
+      await c.subscribe(SERVICE, SAMPLES, (d) =>
+        got.push(new DataView(d.buffer).getUint16(12, true)),
+      );
+      await c.write(SERVICE, COMMANDS, Uint8Array.of(0xc2));
+      await new Promise((r) => setTimeout(r, 300));
+      const elapsed = performance.now() / 1000 - t0;
+      // Pumped every 10 ms on a loaded machine: some samples, in order, none before its time.
+      expect(got.length).toBeGreaterThan(0);
+      expect(got.length).toBeLessThanOrEqual(Math.floor(elapsed * 204.8) + 1);
+      expect(got).toEqual(got.map((_, k) => k));
+    } finally {
+      sim.close();
+    }
+  });
 });
