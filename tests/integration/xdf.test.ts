@@ -9,7 +9,7 @@
  *   no hole, and after `mosaic repair` has footers that agree with its samples.
  */
 import { spawnSync } from "node:child_process";
-import { existsSync, mkdirSync, statSync, writeFileSync } from "node:fs";
+import { existsSync, mkdirSync, readdirSync, readFileSync, statSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
 import { beforeAll, describe, expect, test } from "vitest";
 import { catalog } from "../../app/blocks/catalog";
@@ -133,6 +133,30 @@ describe("XDF recordings read by pyxdf", () => {
     expect(s32).toMatchObject({ channel_format: "float32", labels: ["ch1", "ch2", "ch3"] });
     expect(s32.time_stamps).toEqual(sin.t);
     expect(s32.values).toEqual(sin.v.map((row) => row.map((v) => Math.fround(v))));
+  }, 60_000);
+});
+
+describe("pipelines/examples/record-xdf.yaml", () => {
+  test("records the EMG, the envelope and the Stimulus's captures as pyxdf reads them", () => {
+    const dir = tempDir("mosaic-xdf-example-");
+    writeFileSync(
+      join(dir, "record-xdf.yaml"),
+      readFileSync(join(ROOT, "pipelines/examples/record-xdf.yaml"), "utf8"),
+    );
+    const args = ["--clock", "virtual", "--duration", "14", "--start", String(START)];
+    const r = runCli(["run", join(dir, "record-xdf.yaml"), ...args]);
+    expect(r.code, r.stderr).toBe(0);
+    const made = readdirSync(join(dir, "recordings"));
+    expect(made).toHaveLength(1);
+    expect(made[0]).toMatch(/^\d{4}-\d\d-\d\d_\d\d-\d\d-\d\d\.xdf$/);
+    const x = pyxdf(join(dir, "recordings", made[0]!), true);
+    const [emg, env, cues] = x.streams;
+    expect(emg).toMatchObject({ name: "Emg", type: "EMG", channel_count: 32, n: 28001 });
+    expect(env).toMatchObject({ name: "Envelope", channel_count: 32, nominal_srate: 50, n: 701 });
+    // fist, rest, fist: each capture's start (the label's target) and its stop.
+    expect(cues).toMatchObject({ name: "Cues.trigger", type: "Markers", channel_format: "string" });
+    expect(cues!.values).toEqual([["1"], ["NaN"], ["0"], ["NaN"], ["1"], ["NaN"]]);
+    for (const s of x.streams) expect(s.footer?.sample_count).toBe(s.n);
   }, 60_000);
 });
 

@@ -224,6 +224,34 @@ Dated: { Type: XdfRecorder, Inputs: [Sin], Params: { File: "d/{block}_{date}_{ti
     expect(dated[0]).toMatch(/^d\/Dated_\d{4}-\d\d-\d\d_\d\d-\d\d-\d\d\.xdf$/);
   });
 
+  test("Overwrite: true replaces a file of the same name", async () => {
+    const files = new MemoryFiles();
+    const yaml = `
+Timer: { Type: ScheduledTimer, DesiredRate: 10 }
+Sin: { Type: SinGenerator, Inputs: [Timer] }
+Rec: { Type: XdfRecorder, Inputs: [Sin], Params: { File: o.xdf, Overwrite: true } }
+`;
+    const overwriting = files.resources();
+    const open = overwriting.openWrite!;
+    const asked: (boolean | undefined)[] = [];
+    overwriting.openWrite = (path, o) => {
+      asked.push(o?.overwrite);
+      files.files.delete(path); // what the host does with { overwrite: true }
+      return open(path, o);
+    };
+    for (let k = 0; k < 2; k++) {
+      await runVirtualPipeline(yaml, {
+        catalog,
+        duration: 0.5,
+        start: START,
+        resources: overwriting,
+      });
+    }
+    expect(asked).toEqual([true, true]);
+    expect([...files.files.keys()]).toEqual(["o.xdf"]);
+    expect(files.read("o.xdf").streams[0]!.t.length).toBe(6);
+  });
+
   test("a failed write is reported once and stops the recording; the pipeline runs on", async () => {
     const files = new MemoryFiles();
     files.failAfter = 3;

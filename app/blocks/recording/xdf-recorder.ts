@@ -31,6 +31,12 @@ const params = z.strictObject({
     .describe(
       "Record; false closes the file (with its footers), true opens a new one (can be changed while running)",
     ),
+  Overwrite: z
+    .boolean()
+    .default(false)
+    .describe(
+      "Replace a file of the same name instead of numbering the new one (benchmarks, scratch runs)",
+    ),
   Format: z
     .enum(["float32", "double64"])
     .default("float32")
@@ -189,7 +195,9 @@ class Recorder {
     const now = this.ctx.now();
     const base = expandFileName(this.p.File, now, this.ctx.name);
     try {
-      const { name, handle } = openNumbered(base, (n) => res.openWrite!(n));
+      const { name, handle } = this.p.Overwrite
+        ? { name: base, handle: res.openWrite(base, { overwrite: true }) }
+        : openNumbered(base, (n) => res.openWrite!(n));
       const infos = this.planned.map((s, i) => ({
         ...s,
         createdAt: now,
