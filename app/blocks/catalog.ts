@@ -12,6 +12,7 @@ import { Muovi } from "./devices/muovi";
 import { MuoviSingleProbe } from "./devices/muovi-single-probe";
 import { NilsPod } from "./devices/nilspod";
 import { Quattrocento } from "./devices/quattrocento";
+import { Sessantaquattro } from "./devices/sessantaquattro";
 import { SimulatedOutput } from "./devices/simulated-output";
 import { FeatureSet } from "./features/feature-set";
 import { IntegratedAbsoluteValue } from "./features/integrated-absolute-value";
@@ -148,6 +149,7 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   Muovi,
   MuoviSingleProbe,
   Quattrocento,
+  Sessantaquattro,
   Delsys,
   DLR_ADCBT,
   NilsPod,

@@ -23,6 +23,10 @@ import {
   QuattrocentoSimulator,
   quattrocentoSimulatorOptions,
 } from "../devices/quattrocento-simulator";
+import {
+  SessantaquattroSimulator,
+  sessantaquattroSimulatorOptions,
+} from "../devices/sessantaquattro-simulator";
 
 type OptionSpec = { type: "string" | "boolean"; default?: string | boolean };
 type Values = Record<string, string | boolean | undefined>;
@@ -207,6 +211,28 @@ export const SIMULATORS: Record<string, DeviceSimulator> = {
         lines: [
           `Quattrocento simulator listening on ${sim.host}:${sim.port}: waits for a configuration command (40 bytes, CRC-8), then streams the commanded channels (120, 216, 312 or 408) at the commanded rate (512…10240 Hz), seed ${sim.seed}`,
           "Point Quattrocento's Host and Port there. Ctrl-C stops it.",
+        ],
+        close: () => sim.close(),
+      };
+    },
+  },
+  sessantaquattro: {
+    summary:
+      "OT Bioelettronica Sessantaquattro(+) (TCP client): connects to a Sessantaquattro block's port, streams the channels its command word asks for (int16 or int24 BE, 500–4000 Hz), reconnects when dropped",
+    usage: "--connect HOST:PORT [--model sessantaquattro|sessantaquattro+] [--seed S] [--verbose]",
+    options: {
+      connect: { type: "string" },
+      model: { type: "string" },
+      seed: { type: "string" },
+      verbose: { type: "boolean", default: false },
+    },
+    async start(v, log) {
+      const o = sessantaquattroSimulatorOptions(v);
+      const sim = new SessantaquattroSimulator({ ...o, ...(v.verbose ? { log } : {}) });
+      return {
+        lines: [
+          `${sim.model} simulator connecting to ${o.host}:${o.port} (again every 0.5 s while not connected), seed ${sim.seed}`,
+          "Ctrl-C stops it.",
         ],
         close: () => sim.close(),
       };

@@ -275,6 +275,19 @@ export const SIMULATED_DEVICES: Readonly<Record<string, DeviceRule>> = {
       return emgAtRate(b, env, channels, q.Rate as number);
     },
   },
+  Sessantaquattro: {
+    kind: "source",
+    network: false,
+    becomes:
+      "EmgSimulator with its output channels (Channels, halved in bipolar Mode, plus 4 or 8 Extras) on a new ScheduledTimer at its Rate",
+    substitute: (b, env) => {
+      const q = p(b);
+      const nch = (q.Channels as number | undefined) ?? 64;
+      const bio = q.Mode === "bipolar" ? nch / 2 : nch;
+      const extras = q.Extras === false ? 0 : q.Model === "Sessantaquattro" ? 4 : 8;
+      return emgAtRate(b, env, bio + extras, (q.Rate as number | undefined) ?? 2000);
+    },
+  },
   Delsys: {
     kind: "source",
     network: false,
