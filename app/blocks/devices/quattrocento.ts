@@ -99,8 +99,9 @@ const params = z.strictObject({
         "that carries every connector listed",
     ),
   Select: z
-    .array(z.number().int().min(1))
+    .array(z.number().int().min(1).max(400))
     .min(1)
+    .max(400)
     .optional()
     .describe(
       "1-based channel numbers, within the listed connectors' channels in order, to output " +
