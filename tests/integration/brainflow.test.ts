@@ -205,6 +205,23 @@ Board:
     );
   }, 120_000);
 
+  test("pipelines/devices/mindrove.yaml under --simulate-devices: BrainFlow's synthetic board stands in", () => {
+    requireBuild();
+    const r = runCli(
+      ["run", "pipelines/devices/mindrove.yaml", "--simulate-devices", "--duration", "3", "--json"],
+      { timeoutMs: 90_000 },
+    );
+    expect(r.code, r.stderr).toBe(0);
+    expect(r.stderr).toMatch(
+      /block 'Armband' \(BrainFlow\) simulated by BrainFlow's synthetic board in place of MINDROVE_WIFI_BOARD/,
+    );
+    const tel = telemetry(r.stdout).at(-1)!;
+    const armband = tel.blocks.find((b) => b.name === "Armband")!;
+    expect(armband.text).toMatch(/^streaming from board SYNTHETIC_BOARD/);
+    expect(tel.blocks.find((b) => b.name === "Use")!.events).toBe(armband.events);
+    expect(armband.events).toBeGreaterThan(250);
+  }, 120_000);
+
   test("the sidecar killed mid-run: reported, restarted, the board streams again", async () => {
     requireBuild();
     const dir = tempDir("mosaic-brainflow-");

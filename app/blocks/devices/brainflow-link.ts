@@ -40,6 +40,8 @@ export const enum BoardState {
   Retrying = 3,
   Ended = 4,
   Stopped = 5,
+  /** The session is prepared and streaming, no data yet. */
+  Waiting = 6,
 }
 
 /** What a sidecar tells the link, routed by the block. */
@@ -155,6 +157,10 @@ export function stateText(c: BoardCounts, target: string, lastFailure: string): 
       return c.failures > 0
         ? `connecting to ${target} (attempt ${c.failures + 1})…`
         : `connecting to ${target}…`;
+    case BoardState.Waiting:
+      return c.failures > 0
+        ? `waiting for data from ${target} (attempt ${c.failures + 1})…`
+        : `waiting for data from ${target}…`;
     case BoardState.Streaming:
       return `streaming from ${target}`;
     case BoardState.Retrying:

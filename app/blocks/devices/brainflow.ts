@@ -314,7 +314,8 @@ export const BrainFlow = defineBlock({
       lastFailure = e.message
         .replace(/^RuntimeError: /, "")
         .replace(/ \(at [^()]*, in poll\)$/, "");
-      ctx.error(`BrainFlow: ${lastFailure}`, e.traceback || undefined);
+      // The module raises its own sentences: the traceback says nothing more (others keep it).
+      ctx.error(`BrainFlow: ${lastFailure}`, e.message === lastFailure ? e.traceback : undefined);
       refresh();
     };
 

@@ -158,6 +158,47 @@ const TRIGNO_NATIVE_RATE = 26 / 0.0135;
 /** Myo's EMG as the armband gives it: int8 / 128, filtered on board (no hum). */
 const MYO_EMG = { AmplitudeMv: 0.25, NoiseFloorMv: 0.005, HumMv: 0 };
 
+/** Channel kinds BrainFlow's synthetic board has (BoardShim.get_board_descr(SYNTHETIC_BOARD)). */
+const SYNTHETIC_KINDS = new Set([
+  "exg",
+  "emg",
+  "eeg",
+  "ecg",
+  "eog",
+  "accel",
+  "gyro",
+  "package",
+  "timestamp",
+]);
+
+/** A BrainFlow block on BrainFlow's synthetic board: its kinds, poll rate and silence kept. */
+function brainflowSynthetic(b: BlockSpec): Replacement {
+  const kinds = ((p(b).Channels as string[] | undefined) ?? ["exg"]).filter((k) =>
+    SYNTHETIC_KINDS.has(k),
+  );
+  const keep = Object.fromEntries(
+    ["PollRate", "Silence", "Retry", "LogLevel"].flatMap((k) =>
+      p(b)[k] !== undefined ? [[k, p(b)[k]]] : [],
+    ),
+  );
+  return {
+    blocks: [
+      {
+        name: b.name,
+        type: "BrainFlow",
+        params: {
+          Board: "SYNTHETIC_BOARD",
+          Library: "brainflow",
+          Channels: kinds.length > 0 ? kinds : ["exg"],
+          ...keep,
+        },
+        inputs: [],
+      },
+    ],
+    summary: `BrainFlow's synthetic board in place of ${String(p(b).Board)} (16 EXG channels at 250 Hz, whatever the board's own count and rate)`,
+  };
+}
+
 /**
  * The substitutions, by block type (the canonical `Type`). docs/mosaic-compatibility.md §7
  * mirrors this table.
@@ -361,6 +402,15 @@ export const SIMULATED_DEVICES: Readonly<Record<string, DeviceRule>> = {
         ports: { imu: { block: b.name, port: "imu" } },
         summary: `ImuSimulator, 6 values at ${hz(env.rateOf(timer.block))} (its timer's)`,
       };
+    },
+  },
+  BrainFlow: {
+    kind: "source",
+    network: false,
+    becomes:
+      "the same BrainFlow block on BrainFlow's synthetic board (SYNTHETIC_BOARD: 16 EXG channels at 250 Hz, accel and gyro), its channel kinds kept where the synthetic board has them; needs the Python sidecar",
+    substitute(b) {
+      return brainflowSynthetic(b);
     },
   },
   HannesReceiver: {

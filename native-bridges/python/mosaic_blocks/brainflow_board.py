@@ -51,7 +51,7 @@ HEADER = 8
 H_N, H_STATE, H_LOST, H_RECONNECTS, H_FAILURES, H_RATE, H_CHANNELS, H_TOTAL = range(HEADER)
 
 # States (H_STATE).
-IDLE, CONNECTING, STREAMING, RETRYING, ENDED, STOPPED = range(6)
+IDLE, CONNECTING, STREAMING, RETRYING, ENDED, STOPPED, WAITING = range(7)
 
 CMD_DESCRIBE, CMD_POLL, CMD_STOP = 0, 1, 2
 
@@ -248,6 +248,7 @@ class Reader:
         self.failures = 0
         self.failure: str | None = None
         self.failure_new = False
+        self.ever = False
         self.last_package: float | None = None
         self.package_min: float | None = None
         self.package_max: float | None = None
@@ -275,7 +276,6 @@ class Reader:
         self.state = STOPPED
 
     def run(self) -> None:
-        ever = False
         while not self.stopping.is_set():
             self.state = CONNECTING
             shim = self.shim.BoardShim(self.board, self.inputs)
@@ -286,11 +286,7 @@ class Reader:
                 self.release(shim)
                 self.fail(explain(e, self.target))
                 continue
-            if ever:
-                self.reconnects += 1
-            ever = True
-            self.failures = 0
-            self.state = STREAMING
+            self.state = WAITING
             reason = self.stream(shim)
             self.release(shim)
             if reason == "ended":
@@ -302,6 +298,7 @@ class Reader:
     def stream(self, shim: Any) -> str | None:
         """Reads until stopped (None), the data stops (a reason) or a playback file ends."""
         last_data = time.monotonic()
+        got = False
         while not self.stopping.wait(READ_EVERY):
             try:
                 data = shim.get_board_data()
@@ -309,13 +306,29 @@ class Reader:
                 return f"reading failed: {e}"
             now = time.monotonic()
             if data.shape[1] > 0:
+                if not got:
+                    self.began()
+                    got = True
                 last_data = now
                 self.take(data)
             elif self.silence > 0 and now - last_data > self.silence:
-                if self.playback:
+                if self.playback and got:
                     return "ended"
-                return f"no data for {self.silence:g} s"
+                if got:
+                    return f"no data for {self.silence:g} s"
+                return (
+                    f"the session started but no data came in {self.silence:g} s "
+                    "(is the board on, in range, and this computer on its network or dongle?)"
+                )
         return None
+
+    def began(self) -> None:
+        """The first data of a session: streaming (again, after a failure: a reconnection)."""
+        if self.ever:
+            self.reconnects += 1
+        self.ever = True
+        self.failures = 0
+        self.state = STREAMING
 
     def take(self, data: np.ndarray) -> None:
         package = self.layout["package"]
