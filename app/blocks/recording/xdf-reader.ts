@@ -362,7 +362,13 @@ export function readXdf(src: ByteSource): XdfFile {
     if (c.tag === TAG_FILE_HEADER) fileHeader = decoder.decode(content);
     else if (c.tag === TAG_BOUNDARY) boundaries++;
     else if (c.tag === TAG_STREAM_HEADER) {
-      const header = parseStreamHeader(c.streamId!, decoder.decode(content));
+      let header: XdfStreamHeader;
+      try {
+        header = parseStreamHeader(c.streamId!, decoder.decode(content));
+      } catch (e) {
+        r.reject(c, `a damaged StreamHeader: ${(e as Error).message}`);
+        break;
+      }
       streams.set(c.streamId!, {
         header,
         footer: undefined,

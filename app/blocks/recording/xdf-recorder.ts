@@ -188,7 +188,8 @@ class Recorder {
     if (this.writer !== null) return;
     const res = this.ctx.resources;
     if (res.openWrite === undefined) {
-      this.failure = "no file access in this runtime (browser): nothing is recorded";
+      this.failure =
+        "no file access in this runtime (browser build): nothing is recorded (downloading a recording is not supported yet)";
       this.describe();
       return;
     }

@@ -241,6 +241,46 @@ describe("XDF files: write, read, cut, repair", () => {
     }
   });
 
+  test("other writers' forms: a sample without a timestamp follows the previous one by 1/srate; int16", () => {
+    const b = new ByteBuffer();
+    b.put(Uint8Array.of(0x58, 0x44, 0x46, 0x3a));
+    putXmlChunk(
+      b,
+      2,
+      9,
+      streamHeaderXml(info({ channelCount: 1, nominalRate: 4, labels: ["x"] })).replace(
+        "float32",
+        "int16",
+      ),
+    );
+    // Samples: 3 samples, the first stamped, the next two not (TimeStampBytes 0).
+    const content = [9, 0, 0, 0, 1, 3, 8, ...le64(2), 0xfe, 0xff, 0, 5, 0, 0, 0x00, 0x80];
+    b.put(Uint8Array.from([1, 2 + content.length, 3, 0, ...content]));
+    const x = readXdf(bytesSource(b.used.slice()));
+    expect(x.problem).toBe("");
+    expect([...x.streams[0]!.t]).toEqual([2, 2.25, 2.5]);
+    expect([...x.streams[0]!.values!]).toEqual([-2, 5, -32768]);
+  });
+
+  test("a damaged StreamHeader ends the readable part; the repair drops it", () => {
+    const { file, w } = recordFile();
+    w.close(101);
+    const good = file.bytes;
+    const b = new ByteBuffer();
+    b.put(good);
+    putXmlChunk(b, 2, 7, "<info><channel_count>x</channel_count></info>");
+    const bytes = b.used.slice();
+    expect(readXdf(bytesSource(bytes)).problem).toMatch(
+      /damaged StreamHeader: stream 7: its header has no valid channel_count/,
+    );
+    const plan = planXdfRepair(bytesSource(bytes));
+    expect(plan.keep).toBe(good.length);
+    expect(plan.append.length).toBe(0);
+    expect(plan.messages[0]).toMatch(
+      /^dropped the last \d+ bytes: byte \d+: a damaged StreamHeader/,
+    );
+  });
+
   test("not an XDF file: a clear error", () => {
     expect(() => planXdfRepair(bytesSource(new TextEncoder().encode("EDF+ something")))).toThrow(
       /not an XDF file/,
