@@ -58,6 +58,7 @@ import { LslInlet } from "./lsl/lsl-inlet";
 import { LslMarkerInlet } from "./lsl/lsl-marker-inlet";
 import { LslMarkers } from "./lsl/lsl-markers";
 import { LslOutlet } from "./lsl/lsl-outlet";
+import { EdfRecorder } from "./recording/edf-recorder";
 import { Logger } from "./recording/logger";
 import { XdfRecorder } from "./recording/xdf-recorder";
 import { AdaptiveFilter } from "./signal/adaptive-filter";
@@ -158,6 +159,7 @@ export const BLOCKS: readonly AnyBlockDefinition[] = [
   SimulatedOutput,
   // Recording
   Logger,
+  EdfRecorder,
   XdfRecorder,
   // Testing
   Sink,
