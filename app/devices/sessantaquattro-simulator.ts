@@ -210,6 +210,11 @@ export class SessantaquattroSimulator {
     return this.k;
   }
 
+  /** When the last start word came (performance.now(), ms): samples never run ahead of it. */
+  get startedAt(): number {
+    return this.t0;
+  }
+
   private connect(): void {
     if (this.closed) return;
     const s = connect({ host: this.o.host, port: this.o.port });

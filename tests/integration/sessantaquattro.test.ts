@@ -206,13 +206,12 @@ describe("Sessantaquattro: the device connects to the block", () => {
     const cfg = sim.config!;
     expectExact(h, (k) => want(cfg, 7, k, "mV"), 1000, sim.samples, 300);
 
-    // The device streams at the commanded rate: its count follows the wall clock.
-    const s1 = sim.samples;
-    const t1 = performance.now();
-    await sleep(600);
-    const rate = ((sim.samples - s1) / (performance.now() - t1)) * 1000;
-    expect(rate).toBeGreaterThan(1000 * 0.7);
-    expect(rate).toBeLessThan(1000 * 1.3);
+    // The device streams at the commanded rate: never ahead of it (what it sent is due by the
+    // wall clock since the start word), and not far behind however loaded the machine.
+    await sleep(500);
+    const since = (performance.now() - sim.startedAt) / 1000;
+    expect(sim.samples).toBeLessThanOrEqual(since * 1000);
+    expect(sim.samples).toBeGreaterThan(since * 1000 * 0.5);
 
     h.instance.stop!();
     await until(() => sim.received.length === 2, "the stop word");
@@ -335,7 +334,7 @@ describe("mosaic simulate sessantaquattro + mosaic run", () => {
         `Port: ${port}`,
       ),
     );
-    const run = startCli(["run", file, "--duration", "4", "--json"]);
+    const run = startCli(["run", file, "--duration", "8", "--json"]);
     cleanup.push(() => void run.kill("SIGINT"));
     const out: string[] = [];
     createInterface({ input: run.stdout! }).on("line", (l) => out.push(l));
@@ -357,7 +356,8 @@ describe("mosaic simulate sessantaquattro + mosaic run", () => {
       blocks: { name: string; events: number; text: string }[];
     };
     const amp = summary.blocks.find((b) => b.name === "Amplifier")!;
-    // The simulator connects within the first second or so of the 4 s run (it retries every 0.5 s).
+    // The simulator (a second CLI process, retrying every 0.5 s) connects within the first
+    // seconds of the 8 s run, however slowly the two processes start on a loaded machine.
     expect(amp.events).toBeGreaterThan(2000 * 1.5);
     expect(summary.blocks.find((b) => b.name === "Envelope25")!.events).toBeGreaterThan(25);
     sim.kill("SIGINT");
