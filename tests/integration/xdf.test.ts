@@ -14,6 +14,7 @@ import { join } from "node:path";
 import { beforeAll, describe, expect, test } from "vitest";
 import { catalog } from "../../app/blocks/catalog";
 import { runVirtualPipeline } from "../../app/engine/testing";
+import { bytesSource, XdfChunkReader, type XdfChunk } from "../../app/blocks/recording/xdf-reader";
 import { requireBuild, ROOT, runCli, startCli, tempDir } from "./helpers";
 
 const PYTHON = join(ROOT, "tests/reference/.venv/bin/python");
@@ -226,6 +227,48 @@ describe("kill -9 while recording", () => {
 });
 
 describe("mosaic repair", () => {
+  test("a file torn inside a Samples chunk: pyxdf reads what is whole, the repair cuts and adds footers", () => {
+    const dir = tempDir("mosaic-xdf-torn-");
+    writeFileSync(join(dir, "p.yaml"), EXACT);
+    const args = ["--clock", "virtual", "--duration", "1", "--start", String(START)];
+    expect(runCli(["run", join(dir, "p.yaml"), ...args]).code).toBe(0);
+    // Our file without its last chunks, cut in the middle of the last Samples chunk of Sin.
+    const whole = readFileSync(join(dir, "exact64.xdf"));
+    const reader = new XdfChunkReader(bytesSource(whole));
+    let last: XdfChunk | null = null;
+    for (let c = reader.next(); c !== null; c = reader.next()) {
+      if (c.tag === 3 && c.streamId === 1) last = c;
+    }
+    const cut = Math.floor((last!.offset + last!.end) / 2);
+    const torn = join(dir, "torn.xdf");
+    writeFileSync(torn, whole.subarray(0, cut));
+    const x = pyxdf(torn);
+    expect(x.streams[0]!.footer).toBeNull();
+    const kept = x.streams[0]!.n;
+    expect(kept).toBeGreaterThan(400);
+    expect(kept).toBeLessThan(501);
+
+    const rep = runCli(["repair", torn, "--out", join(dir, "fixed.xdf")]);
+    expect(rep.code, rep.stderr).toBe(0);
+    expect(rep.stdout).toMatch(
+      new RegExp(
+        `torn.xdf: dropped the last ${cut - last!.offset} bytes: byte ${last!.offset}: the file ends inside a chunk`,
+      ),
+    );
+    const y = pyxdf(join(dir, "fixed.xdf"));
+    const s = y.streams[0]!;
+    expect(s.n).toBe(kept);
+    expect(s.footer).toEqual({
+      first_timestamp: START,
+      last_timestamp: s.last,
+      sample_count: kept,
+    });
+    // Never over an existing file.
+    const again = runCli(["repair", torn, "--out", join(dir, "fixed.xdf")]);
+    expect(again.code).toBe(1);
+    expect(again.stderr).toMatch(/exists already/);
+  }, 60_000);
+
   test("usage errors and unknown formats exit 2 with a message", () => {
     const dir = tempDir("mosaic-repair-");
     writeFileSync(join(dir, "a.txt"), "x");
