@@ -55,6 +55,48 @@ export interface InputInfo {
   readonly isTimer: boolean;
   /** False for inputs written `-Name`: declared, subscribed only at run time. */
   readonly subscribed: boolean;
+  /** What the source's channels are (names, unit, electrode grid), when it says. */
+  readonly meta?: PortMeta;
+}
+
+/**
+ * What an output's values are, for people and for recorders: channel names, unit, and where the
+ * channels sit on an electrode grid. Shown by the panels (scope legend, heatmap layout), written
+ * into recordings (XDF channel labels, EDF+ signal labels) and LSL stream descriptions.
+ */
+export interface PortMeta {
+  /** One name per value (rows × cols, row-major), e.g. "sensor 3 (EMG)". */
+  readonly labels?: readonly string[];
+  /** Physical unit of every value ("V", "mV", "g"), when one holds for all. */
+  readonly unit?: string;
+  /** Where the values sit on an electrode grid (HD-EMG arrays): the heatmap's default layout. */
+  readonly grid?: ElectrodeGrid;
+}
+
+export interface ElectrodeGrid {
+  readonly rows: number;
+  readonly cols: number;
+  /** The value (0-based channel) shown in each cell, row-major; -1: no electrode there. */
+  readonly cells: readonly number[];
+  /** The array's name, e.g. "GR10MM0804". */
+  readonly name?: string;
+}
+
+/** Why `meta` does not fit a port of `n` values; undefined when it does. */
+export function portMetaProblem(meta: PortMeta, n: number): string | undefined {
+  if (meta.labels !== undefined && meta.labels.length !== n) {
+    return `${meta.labels.length} channel labels for ${n} values`;
+  }
+  const g = meta.grid;
+  if (g === undefined) return undefined;
+  if (!(Number.isInteger(g.rows) && Number.isInteger(g.cols) && g.rows > 0 && g.cols > 0)) {
+    return `an electrode grid of ${g.rows} × ${g.cols}`;
+  }
+  if (g.cells.length !== g.rows * g.cols) {
+    return `an electrode grid of ${g.rows} × ${g.cols} with ${g.cells.length} cells`;
+  }
+  const bad = g.cells.find((c) => !Number.isInteger(c) || c < -1 || c >= n);
+  return bad === undefined ? undefined : `electrode grid cell ${bad} is not a channel of ${n}`;
 }
 
 /** File access for blocks; paths are resolved against the pipeline file's folder. */
@@ -154,8 +196,12 @@ export interface BlockContext {
   readonly resources: Resources;
   /** Device and network I/O provided by the host (empty in the browser build). */
   readonly io: IoBridges;
-  /** Declares an output port (the first declared port is the default one). */
-  output(shape: Shape, port?: string): OutputPort;
+  /**
+   * Declares an output port (the first declared port is the default one). `meta` names its
+   * channels (and unit, electrode grid); without it a port of the same shape as the block's first
+   * value input inherits that input's meta (a filter keeps its input's channel names).
+   */
+  output(shape: Shape, port?: string, meta?: PortMeta): OutputPort;
   /**
    * The batching interval that applies to this block, s (DESIGN.md §3): its timers' ticks may
    * wait this long to go out together. Self-timed sources (`at`) may batch the same way.

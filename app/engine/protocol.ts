@@ -5,6 +5,7 @@
  * nothing else from the engine but types.
  */
 import { z } from "zod";
+import type { PortMeta } from "./block";
 import type { Diagnostic } from "./diagnostics";
 import type { Shape } from "./frame";
 import type { RuntimeEvent, Telemetry } from "./runtime/runtime";
@@ -126,7 +127,8 @@ export interface BlockInfo {
   timer: boolean;
   desiredRate: number;
   inputs: InputRefInfo[];
-  outputs: { name: string; shape: Shape }[];
+  /** `labels`, `unit`, `grid`: what the port's values are (PortMeta), when known. */
+  outputs: ({ name: string; shape: Shape } & PortMeta)[];
   views: string[];
   panel: string;
   /** Params that can be changed while running. */

@@ -79,8 +79,11 @@ describe("EngineSession", () => {
     const tel = f.sent.filter((m) => m.type === "telemetry");
     expect(tel.length).toBeGreaterThanOrEqual(19);
     const last = tel.at(-1)!;
+    // Every block keeps up (one call measured longer than its period on a loaded machine makes
+    // it stumbling, never lagging).
     expect(
-      last.type === "telemetry" && last.telemetry.blocks.every((b) => b.status === "ontime"),
+      last.type === "telemetry" &&
+        last.telemetry.blocks.every((b) => b.status === "ontime" || b.status === "stumbling"),
     ).toBe(true);
     await s.handle({ type: "stop", id: 3 });
     expect(f.sent.at(-2)).toMatchObject({ type: "state", state: "stopped" });

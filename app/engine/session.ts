@@ -485,7 +485,7 @@ export class EngineSession {
           port: i.port,
           subscribed: i.subscribed,
         })),
-        outputs: node.ports.map((p) => ({ name: p.name, shape: p.shape })),
+        outputs: node.ports.map((p) => ({ name: p.name, shape: p.shape, ...p.meta })),
         views: [...(b.def.views ?? [])],
         panel: b.def.panel ?? "",
         live: [...(b.def.live ?? [])],

@@ -2,14 +2,16 @@
  * Test helpers (Node-RED style: load a tiny flow, feed it, look at what comes out; Timeflux style:
  * set a block's input, call it, check its output). Used by block tests and integration tests.
  */
-import type {
-  AnyBlockDefinition,
-  BlockContext,
-  BlockInstance,
-  InputInfo,
-  OutputPort,
-  Resources,
-  TimerHandle,
+import {
+  portMetaProblem,
+  type AnyBlockDefinition,
+  type BlockContext,
+  type BlockInstance,
+  type InputInfo,
+  type OutputPort,
+  type PortMeta,
+  type Resources,
+  type TimerHandle,
 } from "./block";
 import type { Catalog } from "./catalog";
 import type { IoBridges } from "./io";
@@ -134,6 +136,8 @@ export interface HarnessOptions {
 export class BlockHarness {
   readonly out = new Map<string, Recorded>();
   readonly ports: OutputPort[] = [];
+  /** The PortMeta each output declared, by port name. */
+  readonly metas = new Map<string, PortMeta>();
   instance!: BlockInstance;
   readonly timers: {
     hz: number;
@@ -211,8 +215,11 @@ export class BlockHarness {
       virtual: this.opts.virtual ?? true,
       resources: this.opts.resources ?? noResources,
       io: this.opts.io ?? {},
-      output(shape: Shape, port?: string): OutputPort {
+      output(shape: Shape, port?: string, meta?: PortMeta): OutputPort {
         const name = port ?? "out";
+        const problem = meta && portMetaProblem(meta, shape.rows * shape.cols);
+        if (problem) throw new Error(`output '${name}': ${problem}`);
+        if (meta) h.metas.set(name, meta);
         const pool = new FramePool(shape);
         const rec: Recorded = { t: [], v: [], frames: [] };
         h.out.set(name, rec);

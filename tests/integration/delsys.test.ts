@@ -136,7 +136,7 @@ describe("Delsys ↔ Trigno simulator on loopback", () => {
     expect(n / elapsed).toBeLessThan(1925.926 * 1.1);
     expect(h.text).toMatch(/^stopped · [\d,]+ samples/);
     expect(String(h.instance.actions!.channels!.run())).toMatch(
-      /^channel 1: sensor 8 \(EMG, V\); channel 2: sensor 1 .*channel 8: sensor 4/,
+      /^channel 1: sensor 8 EMG \(V\); channel 2: sensor 1 .*channel 8: sensor 4/,
     );
     expect(TRIGNO_NATIVE_RATE).toBeCloseTo(1925.926, 3);
   });
@@ -146,6 +146,13 @@ describe("Delsys ↔ Trigno simulator on loopback", () => {
     const sensors = [1, 2, 3, 4, 5, 6, 7, 8];
     const h = await block({ Sensors: sensors, Aux: "acc", AuxPort: sim.ports.aux, ...ports(sim) });
     expect(h.ports[0]!.shape).toEqual(vectorShape(32));
+    expect(h.metas.get("emg")!.labels!.slice(0, 5)).toEqual([
+      "sensor 1 EMG (V)",
+      "sensor 1 acc x (g)",
+      "sensor 1 acc y (g)",
+      "sensor 1 acc z (g)",
+      "sensor 2 EMG (V)",
+    ]);
     h.start();
     await until(() => rows(h).length >= 1500, "1500 joined samples");
     // Malformed AUX bytes are counted and skipped; the join goes on.
@@ -176,7 +183,7 @@ describe("Delsys ↔ Trigno simulator on loopback", () => {
     // their EMG samples carry the previous AUX values, held.
     expect(heldOrLost).toBeLessThan(3 * 8 * 13 * 8);
     expect(String(h.instance.actions!.channels!.run())).toMatch(
-      /^channel 1: sensor 1 \(EMG, V\); channel 2: sensor 1 \(acc x, g\); channel 3: sensor 1 \(acc y, g\); channel 4: sensor 1 \(acc z, g\); channel 5: sensor 2 \(EMG, V\)/,
+      /^channel 1: sensor 1 EMG \(V\); channel 2: sensor 1 acc x \(g\); channel 3: sensor 1 acc y \(g\); channel 4: sensor 1 acc z \(g\); channel 5: sensor 2 EMG \(V\)/,
     );
   });
 

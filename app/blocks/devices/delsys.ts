@@ -1,5 +1,11 @@
 import { z } from "zod";
-import { BlockConfigError, defineBlock, vectorShape, type BlockContext } from "../../engine";
+import {
+  BlockConfigError,
+  defineBlock,
+  vectorShape,
+  type BlockContext,
+  type PortMeta,
+} from "../../engine";
 import { plural, TextThrottle } from "../shared/text";
 import {
   DeviceClock,
@@ -97,14 +103,20 @@ export function selectedSensors(s: Params["Sensors"]): number[] {
   return typeof s === "number" ? Array.from({ length: s }, (_, i) => i + 1) : [...s];
 }
 
-/** What each output channel carries, for the `channels` action. */
-function channelNames(sensors: readonly number[], aux: number): string[] {
+/** What each output channel carries: "sensor 3 EMG (V)", "sensor 3 acc x (g)". */
+function channelLabels(sensors: readonly number[], aux: number): string[] {
   const names: string[] = [];
   for (const s of sensors) {
-    names.push(`sensor ${s} (EMG, V)`);
-    for (let j = 0; j < aux; j++) names.push(`sensor ${s} (${AUX_NAMES[j]}, ${AUX_UNITS[j]})`);
+    names.push(`sensor ${s} EMG (V)`);
+    for (let j = 0; j < aux; j++) names.push(`sensor ${s} ${AUX_NAMES[j]} (${AUX_UNITS[j]})`);
   }
-  return names.map((n, i) => `channel ${i + 1}: ${n}`);
+  return names;
+}
+
+/** The output's PortMeta: the labels, and the unit when every channel is EMG. */
+function outputMeta(link: TrignoLinkOptions): PortMeta {
+  const aux = link.aux ?? 0;
+  return { labels: channelLabels(link.sensors, aux), ...(aux === 0 ? { unit: "V" } : {}) };
 }
 
 export const Delsys = defineBlock({
@@ -162,7 +174,10 @@ export const Delsys = defineBlock({
       channels: {
         label: "Channels",
         description: "Which sensor each output channel carries",
-        run: () => channelNames(sensors, link.aux ?? 0).join("; "),
+        run: () =>
+          channelLabels(sensors, link.aux ?? 0)
+            .map((n, i) => `channel ${i + 1}: ${n}`)
+            .join("; "),
       },
       counts: {
         label: "Counts",
@@ -176,6 +191,7 @@ export const Delsys = defineBlock({
         device: "Delsys Trigno",
         target: `${target} (Trigno SDK, TCP)`,
         shape: vectorShape(trignoWidth(link)),
+        meta: outputMeta(link),
         port: "emg",
         // Two TCU frames: a 1926 Hz timer drains each 13.5 ms frame before the next comes.
         maxQueue: 2 * (TRIGNO_NATIVE_SAMPLES + 1),
@@ -232,7 +248,7 @@ function nativeSource(
 ) {
   if (ctx.declaredRate === undefined) ctx.setDesiredRate(TRIGNO_NATIVE_RATE);
   const k = trignoWidth(o);
-  const out = ctx.output(vectorShape(k), "emg");
+  const out = ctx.output(vectorShape(k), "emg", outputMeta(o));
   const clock = new DeviceClock(TRIGNO_NATIVE_RATE);
   const throttle = new TextThrottle(0.5);
   let link: TrignoLink | undefined;

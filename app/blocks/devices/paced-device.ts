@@ -17,6 +17,7 @@ import {
   type BlockContext,
   type BlockInstance,
   type Frame,
+  type PortMeta,
   type Shape,
 } from "../../engine";
 import { inputName } from "../shared/inputs";
@@ -53,6 +54,8 @@ export interface PacedDeviceOptions {
   target: string;
   /** The output's shape (one event per tick). */
   shape: Shape;
+  /** What the channels are (names, unit, electrode grid), for panels and recorders. */
+  meta?: PortMeta;
   /** Output port name (the default port). */
   port: string;
   /** The protocol module; undefined: this version does not speak the device's protocol yet. */
@@ -89,7 +92,7 @@ export function unreachableMessage(device: string, target: string): string {
 
 /** The instance of a timer-paced device block (see the file comment). */
 export function pacedDevice(ctx: BlockContext, o: PacedDeviceOptions): BlockInstance {
-  const out = ctx.output(o.shape, o.port);
+  const out = ctx.output(o.shape, o.port, o.meta);
   const size = shapeSize(o.shape);
   const maxQueue = Math.max(1, o.maxQueue ?? 15);
   const queue = new Float64Array(maxQueue * size);

@@ -14,7 +14,13 @@
  * - `nativeStreamSource`: a block without an input that is its own source at the device's rate,
  *   the samples of each TCP chunk emitted as one frame on the device's sample clock.
  */
-import { vectorShape, type BlockContext, type BlockInstance, type TcpBridge } from "../../engine";
+import {
+  vectorShape,
+  type BlockContext,
+  type BlockInstance,
+  type PortMeta,
+  type TcpBridge,
+} from "../../engine";
 import { plural, TextThrottle } from "../shared/text";
 import { DeviceClock } from "./delsys-protocol";
 
@@ -284,6 +290,8 @@ export function linkCountsText(c: LinkCounts | undefined): string {
 export interface NativeStreamOptions<Raw = Int16Array> {
   /** The device's sample rate, Hz. */
   rate: number;
+  /** What the channels are (names, unit, electrode grid), for panels and recorders. */
+  meta?: PortMeta;
   /** How far ahead of arrival a frame's stamps may run, s (about one packet of the device). */
   maxLead: number;
   /** Output channels (vector [1, channels] per sample). */
@@ -310,7 +318,7 @@ export function nativeStreamSource<Raw = Int16Array>(
 ): BlockInstance {
   if (ctx.declaredRate === undefined) ctx.setDesiredRate(o.rate);
   const k = o.channels;
-  const out = ctx.output(vectorShape(k), "emg");
+  const out = ctx.output(vectorShape(k), "emg", o.meta);
   const clock = new DeviceClock(o.rate, 0.5, o.maxLead);
   const throttle = new TextThrottle(0.5);
   let batch = new Float64Array(64 * k);

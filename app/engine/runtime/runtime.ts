@@ -7,14 +7,16 @@
  * its turn comes. Blocks never re-enter, feedback cycles are fine, and the order of deliveries is
  * deterministic, which the virtual clock relies on for byte-identical logs.
  */
-import type {
-  AnyBlockDefinition,
-  BlockContext,
-  BlockInstance,
-  InputInfo,
-  OutputPort,
-  Resources,
-  TimerHandle,
+import {
+  portMetaProblem,
+  type AnyBlockDefinition,
+  type BlockContext,
+  type BlockInstance,
+  type InputInfo,
+  type OutputPort,
+  type PortMeta,
+  type Resources,
+  type TimerHandle,
 } from "../block";
 import type { Catalog } from "../catalog";
 import { BlockConfigError, errorMessage, type Diagnostic } from "../diagnostics";
@@ -125,7 +127,7 @@ export interface PlanBlock {
   desiredRate: number;
   isTimer: boolean;
   finite: boolean;
-  outputs: { name: string; shape: Shape }[];
+  outputs: { name: string; shape: Shape; meta?: PortMeta }[];
   inputs: { block: string; port: string }[];
   /** The block's declared input queue capacity (events), if any. */
   queueCapacity?: number;
@@ -226,6 +228,8 @@ class Edge {
 
 class OutPort implements OutputPort {
   readonly pool: FramePool;
+  /** Channel names, unit, electrode grid (declared or inherited). */
+  meta: PortMeta | undefined;
   readonly edges: Edge[] = [];
   log: LogChannel | null = null;
   /** Observers of every emitted frame (tests, open control panels); they must copy what they keep. */
@@ -296,6 +300,24 @@ class Node {
   }
 }
 
+/** The port metas of a planned block, by port name. */
+function ghostMetas(p: PlanBlock): Map<string, PortMeta> {
+  const m = new Map<string, PortMeta>();
+  for (const o of p.outputs) if (o.meta !== undefined) m.set(o.name, o.meta);
+  return m;
+}
+
+/**
+ * The meta a port without its own inherits: that of the block's first value input (not a timer)
+ * when it has the same shape (a filter, a gain, a rectifier keep their input's channels).
+ */
+function inheritedMeta(inputs: readonly InputInfo[], shape: Shape): PortMeta | undefined {
+  const first = inputs.find((i) => !i.isTimer && i.shape !== null);
+  if (!first?.meta || !first.shape) return undefined;
+  if (first.shape.rows !== shape.rows || first.shape.cols !== shape.cols) return undefined;
+  return first.meta;
+}
+
 /** A block placed on another worker: known only through the plan. */
 interface Ghost {
   name: string;
@@ -304,6 +326,7 @@ interface Ghost {
   desiredRate: number;
   isTimer: boolean;
   outputs: Map<string, Shape>;
+  metas: Map<string, PortMeta>;
 }
 
 export interface CreateResult {
@@ -472,6 +495,7 @@ export class Runtime {
           desiredRate: p.desiredRate,
           isTimer: p.isTimer,
           outputs: new Map(p.outputs.map((o) => [o.name, o.shape])),
+          metas: ghostMetas(p),
         });
       }
     }
@@ -485,9 +509,9 @@ export class Runtime {
       const inputs: InputInfo[] = b.inputs.map((inp, index) => {
         const src = rt.byName.get(inp.block) ?? planningByName.get(inp.block);
         const ghost = ghosts.get(inp.block);
-        const shape = src
-          ? (src.ports.find((p) => p.name === inp.port)?.shape ?? null)
-          : (ghost?.outputs.get(inp.port) ?? null);
+        const srcPort = src?.ports.find((p) => p.name === inp.port);
+        const shape = src ? (srcPort?.shape ?? null) : (ghost?.outputs.get(inp.port) ?? null);
+        const meta = src ? srcPort?.meta : ghost?.metas.get(inp.port);
         return {
           index,
           source: inp.source,
@@ -500,6 +524,7 @@ export class Runtime {
           rate: src ? src.desiredRate : (ghost?.desiredRate ?? 0),
           isTimer: src ? src.def.timer === true : (ghost?.isTimer ?? false),
           subscribed: inp.subscribed,
+          ...(meta !== undefined ? { meta } : {}),
         };
       });
       let desired = b.desiredRate ?? 0;
@@ -548,7 +573,11 @@ export class Runtime {
           desiredRate: n.desiredRate,
           isTimer: b.def.timer === true,
           finite: n.finite,
-          outputs: n.ports.map((p) => ({ name: p.name, shape: p.shape })),
+          outputs: n.ports.map((p) => ({
+            name: p.name,
+            shape: p.shape,
+            ...(p.meta !== undefined ? { meta: p.meta } : {}),
+          })),
           inputs: b.inputs.map((i) => ({ block: i.block, port: i.port })),
           ...(b.queue.capacity !== undefined ? { queueCapacity: b.queue.capacity } : {}),
         };
@@ -566,6 +595,7 @@ export class Runtime {
           desiredRate: p.desiredRate,
           isTimer: p.isTimer,
           outputs: new Map(p.outputs.map((o) => [o.name, o.shape])),
+          metas: ghostMetas(p),
         });
       }
     }
@@ -641,7 +671,7 @@ export class Runtime {
       virtual: this.virtual,
       resources: this.resources,
       io: this.io,
-      output(shape: Shape, port?: string): OutputPort {
+      output(shape: Shape, port?: string, meta?: PortMeta): OutputPort {
         const name = port ?? node.spec.outputs[node.ports.length] ?? "out";
         if (node.ports.some((p) => p.name === name)) {
           throw new Error(`output '${name}' declared twice`);
@@ -655,6 +685,9 @@ export class Runtime {
           throw new Error(`invalid output shape ${formatShape(shape)}`);
         }
         const p = new OutPort(node, name, shape);
+        p.meta = meta ?? inheritedMeta(inputs, shape);
+        const problem = p.meta && portMetaProblem(p.meta, shape.rows * shape.cols);
+        if (problem) throw new Error(`output '${name}': ${problem}`);
         node.ports.push(p);
         return p;
       },

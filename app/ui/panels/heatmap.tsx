@@ -1,8 +1,9 @@
 /**
  * Heatmap (paper III-C): a matrix value as an image (row 0 at the top), or the channels of a
  * vector on an electrode grid — HD-EMG arrays of 8 × 8 or 16 × 16 — inferred near-square or
- * picked (rows × cols, along rows or along columns). Viridis colour scale with a legend,
- * autoscaled (widens at once, narrows over ~3 s) or fixed. The value per cell is the latest one,
+ * picked (rows × cols, along rows or along columns); a block that declares its electrode array
+ * (PortMeta grid: Muovi, Quattrocento) is drawn on it unless another grid is picked. Viridis
+ * colour scale with a legend, autoscaled (widens at once, narrows over ~3 s) or fixed. The value per cell is the latest one,
  * a moving mean, or a moving mean of |x| (the envelope: what an activation map of raw EMG shows;
  * the default for outputs faster than 100 Hz). One pixel per cell in an offscreen image, scaled
  * up without smoothing; redrawn at most once per frame, only when new data arrived.
@@ -16,6 +17,7 @@ import {
   type MouseEvent,
   type ReactNode,
 } from "react";
+import type { ElectrodeGrid } from "../../engine/block";
 import type { DataMessage } from "../../engine/protocol";
 import { useBlockData } from "../client/hooks";
 import {
@@ -71,6 +73,16 @@ interface Layout {
   matrix: boolean;
 }
 
+/** The layout of an electrode array the block declared (its PortMeta grid). */
+function declaredLayout(n: number, grid: ElectrodeGrid): Layout {
+  const cellOfValue = new Int32Array(n).fill(-1);
+  const valueOfCell = Int32Array.from(grid.cells);
+  grid.cells.forEach((k, cell) => {
+    if (k >= 0 && k < n) cellOfValue[k] = cell;
+  });
+  return { rows: grid.rows, cols: grid.cols, cellOfValue, valueOfCell, matrix: false };
+}
+
 function layoutFor(
   shape: { rows: number; cols: number },
   gridRows: number,
@@ -107,11 +119,16 @@ export function Heatmap({
   const n = rows * cols;
   const reduce: Reduce = settings.reduce ?? (block.desiredRate > 100 ? "envelope" : "latest");
   const inferred = inferGrid(cols);
-  const gridRows = settings.gridRows ?? inferred.rows;
-  const gridCols = settings.gridCols ?? inferred.cols;
+  // The block's own electrode array, unless another grid was picked.
+  const declared = rows === 1 && settings.gridRows === undefined ? output.grid : undefined;
+  const gridRows = settings.gridRows ?? declared?.rows ?? inferred.rows;
+  const gridCols = settings.gridCols ?? declared?.cols ?? inferred.cols;
   const layout = useMemo(
-    () => layoutFor(output.shape, gridRows, gridCols, settings.columnMajor),
-    [output.shape, gridRows, gridCols, settings.columnMajor],
+    () =>
+      declared
+        ? declaredLayout(n, declared)
+        : layoutFor(output.shape, gridRows, gridCols, settings.columnMajor),
+    [output.shape, declared, n, gridRows, gridCols, settings.columnMajor],
   );
   const statsKey = `heatmap:${block.name}.${output.name}`;
   const canvas = useRef<HTMLCanvasElement>(null);
@@ -218,7 +235,8 @@ export function Heatmap({
   };
 
   const choices = gridChoices(cols);
-  const gridKey = `${gridRows}x${gridCols}`;
+  const gridKey = declared ? "declared" : `${gridRows}x${gridCols}`;
+  const known = gridKey === "declared" || choices.some((g) => `${g.rows}x${g.cols}` === gridKey);
   return (
     <div className="mp-heatmap" data-view="heatmap" data-block={block.name} data-port={output.name}>
       <div className="mp-toolbar" role="toolbar" aria-label="Heatmap settings">
@@ -229,13 +247,23 @@ export function Heatmap({
             <label className="mp-field" title="Electrode grid: rows × columns">
               Grid
               <select
-                value={choices.some((g) => `${g.rows}x${g.cols}` === gridKey) ? gridKey : "custom"}
+                value={known ? gridKey : "custom"}
                 onChange={(e) => {
+                  if (e.target.value === "declared") {
+                    onSettings({ gridRows: undefined, gridCols: undefined });
+                    return;
+                  }
                   const [r, c] = e.target.value.split("x").map(Number);
                   if (r && c) onSettings({ gridRows: r, gridCols: c });
                 }}
               >
-                {!choices.some((g) => `${g.rows}x${g.cols}` === gridKey) && (
+                {output.grid && (
+                  <option value="declared">
+                    {output.grid.name ?? "electrode array"} ({output.grid.rows} × {output.grid.cols}
+                    )
+                  </option>
+                )}
+                {!known && (
                   <option value="custom">
                     {gridRows} × {gridCols}
                   </option>
@@ -247,16 +275,18 @@ export function Heatmap({
                 ))}
               </select>
             </label>
-            <label className="mp-field" title="How channels fill the grid">
-              Order
-              <select
-                value={settings.columnMajor ? "col" : "row"}
-                onChange={(e) => onSettings({ columnMajor: e.target.value === "col" })}
-              >
-                <option value="row">along rows</option>
-                <option value="col">along columns</option>
-              </select>
-            </label>
+            {!declared && (
+              <label className="mp-field" title="How channels fill the grid">
+                Order
+                <select
+                  value={settings.columnMajor ? "col" : "row"}
+                  onChange={(e) => onSettings({ columnMajor: e.target.value === "col" })}
+                >
+                  <option value="row">along rows</option>
+                  <option value="col">along columns</option>
+                </select>
+              </label>
+            )}
           </>
         )}
         <label className="mp-field">

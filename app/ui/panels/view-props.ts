@@ -1,11 +1,14 @@
 import type { ReactNode } from "react";
+import type { ElectrodeGrid } from "../../engine/block";
 import type { BlockInfo } from "../../engine/protocol";
 
-/** One output of a block, as BlockInfo lists it (labels: optional channel names, proposed). */
+/** One output of a block, as BlockInfo lists it (labels, unit, grid: its PortMeta, when known). */
 export interface OutputInfo {
   name: string;
   shape: { rows: number; cols: number };
-  labels?: string[];
+  labels?: readonly string[];
+  unit?: string;
+  grid?: ElectrodeGrid;
 }
 
 /** What every data view of a control panel gets. */
