@@ -294,6 +294,30 @@ describe("Sessantaquattro: the device connects to the block", () => {
     );
   });
 
+  test("a new connection replaces the current one, which is closed", async () => {
+    const port = await freePort();
+    const h = await harness({ Port: port, Channels: 8, Rate: 500 });
+    h.start();
+    await until(() => /^waiting/.test(h.text), "listening");
+    const { createConnection } = await import("node:net");
+    const stale = createConnection({ host: "127.0.0.1", port });
+    const got: number[] = [];
+    let closed = false;
+    stale.on("data", (d) => got.push(...d));
+    stale.on("close", () => (closed = true));
+    stale.on("error", () => {});
+    cleanup.push(() => void stale.destroy());
+    await until(() => got.length === 2, "the command word");
+    expect(got).toEqual([0x00, 0x41]); // FSAMP 0, NCH 0, MODE 0, HPF, GO
+    const sim = device(port, 2);
+    await until(() => closed, "the stale connection closed by the block");
+    await until(() => emitted(h).v.length >= 50, "samples from the new one");
+    const cfg = sim.config!;
+    const k0 = findK(emitted(h).v[0]!, (k) => want(cfg, 2, k, "mV"), sim.samples);
+    expect(k0).toBeGreaterThanOrEqual(0);
+    expect(sim.connections).toBe(1);
+  });
+
   test("a taken port and no TCP say what happens and what to do", async () => {
     const taken = createServer();
     await new Promise<void>((r) => taken.listen(0, "0.0.0.0", r));

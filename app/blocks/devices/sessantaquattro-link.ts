@@ -140,8 +140,13 @@ export class SessantaquattroLink extends StreamLink<Int32Array> {
   }
 
   private onPeer(remote: { host: string; port: number }, peer: TcpSocketHandle) {
-    // A new connection: an older one (if any) has ended; this one is current.
+    // A new connection replaces an older one (a device that reconnected before its old
+    // connection timed out): the old one is closed and what its stream left is dropped.
     const gen = ++this.gen;
+    if (this.peer) {
+      this.peer.close();
+      this.endStream();
+    }
     this.peer = peer;
     this.peerName = peerText(remote);
     this.lastData = this.ctx.now();
