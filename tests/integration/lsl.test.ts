@@ -9,6 +9,9 @@
  * it): MOSAIC's LslOutlet → pylsl and pylsl → MOSAIC's LslInlet, every value exact, no sample
  * lost or repeated, every timestamp within 1 ms of the time it was given (mapped between the
  * pipeline clock and LSL's clock by an offset this test measures on its own). About 13 s.
+ * The others: markers both ways, blocks to blocks in this process (int32 markers, a refused
+ * channel count, a lost stream recovered), no bridge, a missing library, and `mosaic run` of
+ * pipelines/examples/lsl-outlet.yaml read by pylsl (needs dist/). The whole file: about 30 s.
  */
 import { spawn, type ChildProcess } from "node:child_process";
 import { existsSync, writeFileSync } from "node:fs";
@@ -23,7 +26,7 @@ import { measureOffset } from "../../app/blocks/lsl/clock-map";
 import { Frame, vectorShape, type AnyBlockDefinition } from "../../app/engine";
 import { BlockHarness } from "../../app/engine/testing";
 import { liblslCandidates, liblslMissing, nodeLslBridge } from "../../native-bridges/lsl";
-import { ROOT, tempDir } from "./helpers";
+import { CLI, requireBuild, ROOT, tempDir } from "./helpers";
 
 const PYTHON = join(ROOT, "tests", "reference", ".venv", "bin", "python");
 const PEER = join(ROOT, "tests", "integration", "lsl_peer.py");
@@ -352,6 +355,40 @@ describe.runIf(available)(
     });
   },
 );
+
+describe.runIf(available)("mosaic run of pipelines/examples/lsl-outlet.yaml", () => {
+  test("pylsl reads its EMG stream (32 ch, 2 kHz, 1/2000 s apart) and the Stimulus's markers", async () => {
+    requireBuild();
+    const run = spawn(
+      process.execPath,
+      [CLI, "run", join(ROOT, "pipelines", "examples", "lsl-outlet.yaml"), "--duration", "8"],
+      { cwd: ROOT, env: { ...process.env, LSLAPICFG: CFG, NO_COLOR: "1" } },
+    );
+    let out = "";
+    run.stdout.on("data", (d: Buffer) => (out += d.toString()));
+    run.stderr.on("data", (d: Buffer) => (out += d.toString()));
+    cleanup.push(() => {
+      if (run.exitCode === null) run.kill();
+    });
+    const py = peer("example", "5");
+    const got = await py.next("example-read", 40_000);
+    expect(got).toMatchObject({
+      channels: 32,
+      rate: 2000,
+      format: 1, // pylsl's cf_float32
+      labels: Array.from({ length: 32 }, (_, c) => `Ch${c + 1}`),
+    });
+    // A loaded machine may start late or pause; a healthy one gets ~10,000 samples in 5 s.
+    expect(got.samples as number).toBeGreaterThan(2000);
+    expect(got.step_min as number).toBeCloseTo(1 / 2000, 6);
+    expect(got.step_max as number).toBeCloseTo(1 / 2000, 6);
+    // The capture of the first task (fist) starts 2 s after the start and ends 1 s later.
+    expect((got.markers as string[]).slice(0, 2)).toEqual(["fist", "stop"]);
+    const code = await new Promise<number | null>((r) => run.on("exit", (c) => r(c)));
+    expect(code, out).toBe(0);
+    expect(out).toMatch(/LslOutlet .*streaming 'MosaicEMG' \(32 ch float32 @ 2000 Hz\)/);
+  });
+});
 
 test("a missing liblsl is reported with where it was looked for and what to do", () => {
   expect(liblslCandidates({ MOSAIC_LIBLSL: "/nowhere/liblsl.so" })).toEqual(["/nowhere/liblsl.so"]);

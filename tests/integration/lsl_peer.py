@@ -8,6 +8,7 @@ Both directions at once, each in its own thread, printing one JSON line per even
     for a consumer, then pushes N samples in real time in small chunks, sample k carrying
     -(k * 32 + c) / 4 + 0.125 and the timestamp t0 + k / RATE (t0 reported in "outlet-start").
 Markers mode: reads MOSAIC's marker stream and sends string markers back (see markers()).
+Example mode: reads pipelines/examples/lsl-outlet.yaml's streams (see read_example()).
 
 Discovery follows LSLAPICFG (the test's lsl_api.cfg: this machine only).
 """
@@ -122,6 +123,44 @@ def markers(name_in, name_out):
     sys.stdin.read()
 
 
+def read_example(seconds):
+    """Reads pipelines/examples/lsl-outlet.yaml's two streams for `seconds`."""
+    emg = pylsl.resolve_byprop("name", "MosaicEMG", 1, 30)
+    cues = pylsl.resolve_byprop("name", "MosaicCues", 1, 30)
+    if not emg or not cues:
+        say({"event": "example-failed", "why": "MosaicEMG or MosaicCues not found"})
+        return
+    i = pylsl.StreamInlet(emg[0], max_buflen=60)
+    j = pylsl.StreamInlet(cues[0], max_buflen=60)
+    i.open_stream(10)
+    j.open_stream(10)
+    info = i.info(10)
+    n = 0
+    stamps = []
+    marks = []
+    end = time.time() + seconds
+    while time.time() < end:
+        chunk, ts = i.pull_chunk(timeout=0.1, max_samples=8192)
+        n += len(chunk)
+        stamps += ts
+        chunk, ts = j.pull_chunk(timeout=0.0)
+        marks += [m[0] for m in chunk]
+    steps = [b - a for a, b in zip(stamps, stamps[1:])] or [0.0]
+    say(
+        {
+            "event": "example-read",
+            "channels": info.channel_count(),
+            "rate": info.nominal_srate(),
+            "format": info.channel_format(),
+            "labels": labels_of(info),
+            "samples": n,
+            "step_min": min(steps),
+            "step_max": max(steps),
+            "markers": marks,
+        }
+    )
+
+
 def main():
     mode = sys.argv[1]
     if mode == "stream":
@@ -136,6 +175,8 @@ def main():
             t.join()
     elif mode == "markers":
         markers("MosaicMarkers", "PyMarkers")
+    elif mode == "example":
+        read_example(float(sys.argv[2]))
 
 
 if __name__ == "__main__":
