@@ -1,5 +1,11 @@
 import { z } from "zod";
-import { BlockConfigError, defineBlock } from "../../engine";
+import {
+  BlockConfigError,
+  defineBlock,
+  errorMessage,
+  type ElectrodeGrid,
+  type PortMeta,
+} from "../../engine";
 import {
   ANALOG_OUT_GAINS,
   AUX_MV_PER_BIT,
@@ -24,6 +30,7 @@ import {
 } from "./quattrocento-protocol";
 import { QuattrocentoLink, quattrocentoTarget } from "./quattrocento-link";
 import { linkCountsText, nativeStreamSource } from "./stream-link";
+import { electrodeGrid, gridParam, type GridParam } from "./electrode-arrays";
 
 const literals = <T extends number>(values: readonly T[]) =>
   z.union(values.map((v) => z.literal(v)) as unknown as [z.ZodLiteral<T>, z.ZodLiteral<T>]);
@@ -107,6 +114,7 @@ const params = z.strictObject({
       "1-based channel numbers, within the listed connectors' channels in order, to output " +
         "(in this order); default all of them",
     ),
+  Grid: gridParam(),
   Unit: z
     .enum(["mV", "raw"])
     .default("mV")
@@ -277,6 +285,7 @@ export const Quattrocento = defineBlock({
     const o = { host: p.Host, port: p.Port, config, outputs: chans.length };
     const instance = nativeStreamSource(ctx, {
       rate: p.Rate,
+      meta: channelMeta(chans, unit, p.Grid),
       maxLead: 0.05,
       channels: chans.length,
       target: quattrocentoTarget(p.Host, p.Port),
@@ -293,3 +302,18 @@ export const Quattrocento = defineBlock({
     return { ...instance, actions };
   },
 });
+
+/** Labels "IN1/3" (the channels action's names), the unit, and the electrode array if given. */
+function channelMeta(
+  chans: readonly { name: string }[],
+  unit: string,
+  grid: GridParam | undefined,
+): PortMeta {
+  let g: ElectrodeGrid | undefined;
+  try {
+    g = electrodeGrid(grid, chans.length);
+  } catch (e) {
+    throw new BlockConfigError(errorMessage(e), "Grid");
+  }
+  return { labels: chans.map((c) => c.name), unit, ...(g ? { grid: g } : {}) };
+}
