@@ -164,6 +164,10 @@ function targetOf(p: Params): string {
 
 const WARN_EVERY_S = 5;
 
+const VIRTUAL_WARNING =
+  "BrainFlow boards run in real time: under the virtual clock this block emits what the board " +
+  "delivered by each poll, so a fast virtual run gets few samples; run it in real time";
+
 /** The playback board (the same id in brainflow and mindrove) plays a file to its end. */
 const isPlayback = (board: string | number): boolean =>
   board === -3 || /^playback(_file(_board)?)?$/i.test(String(board).trim());
@@ -201,7 +205,9 @@ export const BrainFlow = defineBlock({
     "board (SYNTHETIC_BOARD) and playback board (PLAYBACK_FILE_BOARD with `File` and " +
     "`MasterBoard`, which plays a file written by DataFilter.write_file) are the simulators, " +
     "and `--simulate-devices` runs the block on the synthetic board of its library; a playback " +
-    "that reaches the end of its file finishes the run. Tested here on the synthetic and " +
+    "that reaches the end of its file finishes the run. The board runs in real time even " +
+    "under the virtual clock (each poll is waited for, but a fast virtual run gets few samples: a " +
+    "warning says so). Tested here on the synthetic and " +
     "playback boards only. Needs `mosaic run`, `mosaic serve` or the desktop app (the browser " +
     "build has no Python: the status says so). Protocol notes in docs/protocols.md.",
   params,
@@ -368,7 +374,9 @@ export const BrainFlow = defineBlock({
     return {
       start() {
         running = true;
+        clock.restart();
         timer.start();
+        if (ctx.virtual) ctx.warn(VIRTUAL_WARNING);
         refresh();
       },
       stop() {

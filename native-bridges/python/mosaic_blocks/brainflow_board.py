@@ -274,6 +274,9 @@ class Reader:
             self.thread.join(timeout=5)
         self.thread = None
         self.state = STOPPED
+        with self.lock:  # a later start begins a new stream
+            self.queue.clear()
+        self.last_package = None
 
     def run(self) -> None:
         while not self.stopping.is_set():
