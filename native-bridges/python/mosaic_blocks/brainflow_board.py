@@ -260,19 +260,21 @@ class Reader:
 
     def start(self) -> None:
         global _active
-        if self.thread is None or not self.thread.is_alive():
-            if _active is not None and _active is not self:
-                _active.stop()  # a reset made a new state: one session per sidecar
-            _active = self
-            self.stopping.clear()
-            self.thread = threading.Thread(target=self.run, name="mosaic-brainflow", daemon=True)
-            self.thread.start()
+        if self.thread is not None and self.thread.is_alive():
+            return  # running, or a stopped session still ending (a later poll starts anew)
+        if _active is not None and _active is not self:
+            _active.stop()  # a reset made a new state: one session per sidecar
+        _active = self
+        self.stopping.clear()
+        self.thread = threading.Thread(target=self.run, name="mosaic-brainflow", daemon=True)
+        self.thread.start()
 
     def stop(self) -> None:
         self.stopping.set()
         if self.thread is not None:
-            self.thread.join(timeout=5)
-        self.thread = None
+            self.thread.join(timeout=5)  # a board inside prepare_session may take longer
+            if not self.thread.is_alive():
+                self.thread = None
         self.state = STOPPED
         with self.lock:  # a later start begins a new stream
             self.queue.clear()

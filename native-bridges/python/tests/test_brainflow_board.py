@@ -3,6 +3,7 @@ on BrainFlow's own synthetic and playback boards (real BrainFlow sessions; no de
 
 from __future__ import annotations
 
+import collections
 import time
 
 import numpy as np
@@ -139,3 +140,15 @@ def test_gaps_in_package_numbers():
     assert state.lost == 3
     state.count_gaps(np.array([255.0, 0, 1]))  # 10…254 missing, then a wrap without loss
     assert state.lost == 3 + 245
+
+
+def test_stop_then_poll_starts_a_new_stream():
+    state = B.init({"board": "synthetic", "channels": ["package"]})
+    try:
+        first, _ = drain(state, 0.5)
+        B.poll(STOP, state)
+        assert state.thread is None and state.queue == collections.deque()
+        again, header = drain(state, 1.0, until=lambda h: h[B.H_N] > 0)
+    finally:
+        B.poll(STOP, state)
+    assert len(first) > 0 and len(again) > 0 and header[B.H_STATE] == B.STREAMING
