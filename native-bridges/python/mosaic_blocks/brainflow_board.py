@@ -219,14 +219,17 @@ class Reader:
         self.master = board_id(self.shim, master, self.lib, "master board") if master not in (None, "") else None
         playback = self.board in (int(self.shim.BoardIds.PLAYBACK_FILE_BOARD), int(self.shim.BoardIds.STREAMING_BOARD))
         if playback and self.master is None:
-            raise ValueError("the playback and streaming boards need master_board (the board that recorded the data)")
+            raise ValueError(
+                "the playback and streaming boards need a master board (the board that recorded the data)"
+            )
         self.playback = self.board == int(self.shim.BoardIds.PLAYBACK_FILE_BOARD)
         described = self.master if playback else self.board
         kinds = [str(k) for k in (params.get("channels") or ["exg"])]
         self.layout = layout(self.shim, described, kinds)
         self.inputs = input_params(params_class, params.get("input") or {}, self.master)
         if self.playback and not os.path.isfile(self.inputs.file):
-            raise ValueError(f"the playback file {self.inputs.file or '(none given)'} does not exist")
+            given = self.inputs.file
+            raise ValueError(f"the playback file {given} does not exist" if given else "the playback board needs a playback file")
         poll_rate = float(params.get("poll_rate", 50))
         self.max_rows = int(params.get("max_rows") or max(32, math.ceil(4 * self.layout["rate"] / poll_rate)))
         self.width = max(HEADER, len(self.layout["rows"]))

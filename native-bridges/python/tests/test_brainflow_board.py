@@ -58,7 +58,7 @@ def test_layout_and_describe():
     assert state.thread is None  # describing opens nothing
     with pytest.raises(ValueError, match="no gyro channels"):
         B.init({"board": "cyton", "channels": ["gyro"]})
-    with pytest.raises(ValueError, match="need master_board"):
+    with pytest.raises(ValueError, match="need a master board"):
         B.init({"board": "playback", "input": {"file": "x.csv"}})
     with pytest.raises(ValueError, match="playback file .* does not exist"):
         B.init({"board": "playback", "master_board": "synthetic", "input": {"file": "/nonexistent.csv"}})
