@@ -13,7 +13,7 @@ import {
   parseTals,
   type EdfHeader,
 } from "./edf-reader";
-import { repairEdf } from "./edf-repair";
+import { planEdfFileRepair, repairEdf } from "./edf-repair";
 import { autoRange } from "./edf-stream";
 
 /** Files in memory, written through the same FileWriteHandle interface as the Node host's. */
@@ -380,6 +380,17 @@ describe("edf repair", () => {
         size = len;
       },
     };
+    // What mosaic repair writes: the whole records kept, the count patched.
+    const plan = planEdfFileRepair(file);
+    expect(plan.keep).toBe(hdr.headerBytes + 5 * hdr.recordBytes);
+    expect(plan.append.length).toBe(0);
+    expect(plan.patches).toEqual([{ at: 236, bytes: new TextEncoder().encode("5       ") }]);
+    expect(plan.changed).toBe(true);
+    expect(plan.messages).toEqual([
+      "EDF+ with 3 signals: 5 whole data records of 0.1 s (0.500 s)",
+      "drops a torn last record (17 bytes)",
+      "sets the header's number of data records from -1 to 5",
+    ]);
     expect(repairEdf(file)).toBe(
       "repaired: cut a torn last record (17 bytes), set the number of data records from -1 to 5; 5 data records (0.500 s)",
     );
@@ -389,6 +400,7 @@ describe("edf repair", () => {
       Array.from({ length: 50 }, (_, i) => i),
     );
     expect(repairEdf(file)).toBe("intact: 5 data records (0.500 s)");
+    expect(planEdfFileRepair(file).changed).toBe(false);
     expect(() => repairEdf({ ...file, size: 10 })).toThrow(/too short for an EDF\/BDF header/);
   });
 });

@@ -43,7 +43,7 @@ export function planEdfRepair(header: Uint8Array, fileSize: number): EdfRepairPl
   };
 }
 
-function readAll(f: RepairableFile, into: Uint8Array, position: number): void {
+function readAll(f: Pick<RepairableFile, "read">, into: Uint8Array, position: number): void {
   let done = 0;
   while (done < into.length) {
     const n = f.read(into.subarray(done), position + done);
@@ -52,8 +52,8 @@ function readAll(f: RepairableFile, into: Uint8Array, position: number): void {
   }
 }
 
-/** Repairs `f` in place; returns one line saying what was done. */
-export function repairEdf(f: RepairableFile): string {
+/** Reads the header of `f` and plans its repair. */
+function planFile(f: Pick<RepairableFile, "size" | "read">): EdfRepairPlan {
   if (f.size < 256) {
     throw new Error(
       `${f.size} bytes: too short for an EDF/BDF header (256 bytes at least), nothing to repair`,
@@ -63,7 +63,50 @@ export function repairEdf(f: RepairableFile): string {
   readAll(f, first, 0);
   const header = new Uint8Array(headerSize(first));
   readAll(f, header, 0);
-  const plan = planEdfRepair(header, f.size);
+  return planEdfRepair(header, f.size);
+}
+
+/** Bytes to overwrite in what a repair keeps. */
+export interface EdfPatch {
+  at: number;
+  bytes: Uint8Array;
+}
+
+/**
+ * The repair as `mosaic repair` writes it (app/cli/repair.ts's table by extension): keep the
+ * header and the whole records, append nothing, patch the header's record count.
+ */
+export function planEdfFileRepair(f: Pick<RepairableFile, "size" | "read">): {
+  keep: number;
+  append: Uint8Array;
+  patches: EdfPatch[];
+  changed: boolean;
+  messages: string[];
+} {
+  const plan = planFile(f);
+  const h = plan.header;
+  const seconds = (plan.records * h.recordDuration).toFixed(3);
+  const messages = [
+    `${h.format.toUpperCase()}+ with ${h.signals.length} signals: ${plan.records} whole data records of ${h.recordDuration} s (${seconds} s)`,
+  ];
+  if (plan.tornBytes > 0) messages.push(`drops a torn last record (${plan.tornBytes} bytes)`);
+  const patches: EdfPatch[] = [];
+  if (plan.was !== plan.records) {
+    patches.push({ at: RECORDS_OFFSET, bytes: recordsField(plan.records) });
+    messages.push(`sets the header's number of data records from ${plan.was} to ${plan.records}`);
+  }
+  return {
+    keep: h.headerBytes + plan.records * h.recordBytes,
+    append: new Uint8Array(0),
+    patches,
+    changed: !plan.intact,
+    messages,
+  };
+}
+
+/** Repairs `f` in place; returns one line saying what was done. */
+export function repairEdf(f: RepairableFile): string {
+  const plan = planFile(f);
   const d = plan.header.recordDuration;
   const what = `${plan.records} data records (${(plan.records * d).toFixed(3)} s)`;
   if (plan.intact) return `intact: ${what}`;
