@@ -100,14 +100,18 @@ Board:
     const pkg = rows.map((row) => row[17]!);
     const steps = pkg.slice(1).map((p, i) => (((p - pkg[i]!) % 256) + 256) % 256);
     expect(steps.filter((s) => s !== 1)).toEqual([]);
-    // The count is the board's rate × the time it streamed, by BrainFlow's own arrival stamps
-    // (the synthetic board delivers in bursts: a burst's worth of slack, 0.1 s).
+    // The count against BrainFlow's own arrival stamps: never more than 250 Hz × the time it
+    // streamed (no repeats), and near it (the synthetic board paces itself with a 4 ms sleep per
+    // sample, so a loaded machine slows it: a loose lower bound; the package numbers above are
+    // the exact check that nothing was lost).
     const ts = rows.map((row) => row[18]!);
     const streamed = ts.at(-1)! - ts[0]!;
-    expect(Math.abs(rows.length - 1 - 250 * streamed)).toBeLessThan(25);
-    // Our stamps run on the board's sample clock: 4 ms apart.
-    const dt = (rows.at(-1)![0]! - rows[0]![0]!) / (rows.length - 1);
-    expect(dt).toBeCloseTo(0.004, 4);
+    expect(rows.length - 1).toBeLessThanOrEqual(250 * streamed + 3);
+    expect(rows.length - 1).toBeGreaterThan(0.8 * 250 * streamed);
+    // Our stamps (logged to the µs) run on the board's sample clock: 4 ms apart (re-anchored to
+    // the arrival time when the board falls behind its nominal rate by more than 0.5 s).
+    const on4ms = rows.slice(1).filter((row, i) => Math.abs(row[0]! - rows[i]![0]! - 0.004) < 2e-6);
+    expect(on4ms.length).toBeGreaterThan(0.95 * (rows.length - 1));
     const last = telemetry(r.stdout)
       .at(-1)!
       .blocks.find((b) => b.name === "Board")!;
