@@ -6,6 +6,7 @@
 import { z } from "zod";
 import { BlockConfigError, type BlockContext, type InputInfo } from "../../engine";
 import { findInput, inputName, signalInput } from "../shared/inputs";
+import { MAX_CHANNELS, MAX_ITEMS } from "../shared/limits";
 import { chooseRecordDuration, type RecordDuration } from "./edf-duration";
 import { FORMATS, toAscii, type EdfFormat } from "./edf-writer";
 import type { EdfStreamInput } from "./edf-stream";
@@ -38,7 +39,7 @@ export const edfParams = z.strictObject({
       "Record; false finishes the file and true starts a new one (can be changed while running)",
     ),
   PhysicalRange: z
-    .union([range, z.array(range).min(1)])
+    .union([range, z.array(range).min(1).max(MAX_CHANNELS)])
     .optional()
     .describe(
       "[min, max] in Dimension units for every signal, or one [min, max] per signal channel in " +
@@ -47,7 +48,7 @@ export const edfParams = z.strictObject({
         "1, 2 or 5 × 10^k (±1 when that record is all zeros)",
     ),
   Dimension: z
-    .union([z.string().max(8), z.array(z.string().max(8)).min(1)])
+    .union([z.string().max(8), z.array(z.string().max(8)).min(1).max(MAX_CHANNELS)])
     .optional()
     .describe(
       "Physical dimension (8 ASCII characters at most): one for all, or one per channel. " +
@@ -55,6 +56,7 @@ export const edfParams = z.strictObject({
     ),
   Labels: z
     .array(z.string().min(1).max(16))
+    .max(MAX_CHANNELS)
     .optional()
     .describe(
       "One label per signal channel, in input order (16 ASCII characters at most). Default: the " +
@@ -72,6 +74,7 @@ export const edfParams = z.strictObject({
     ),
   Markers: z
     .array(z.string().min(1))
+    .max(MAX_ITEMS)
     .optional()
     .describe(
       "Inputs written as annotations rather than signals. Default: aperiodic inputs (a " +
