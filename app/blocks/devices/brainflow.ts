@@ -1,5 +1,11 @@
 import { z } from "zod";
-import { defineBlock, vectorShape, type BlockContext, type PythonCallError } from "../../engine";
+import {
+  BlockConfigError,
+  defineBlock,
+  vectorShape,
+  type BlockContext,
+  type PythonCallError,
+} from "../../engine";
 import { plural, TextThrottle } from "../shared/text";
 import { DeviceClock } from "./delsys-protocol";
 import {
@@ -142,7 +148,7 @@ function moduleParams(ctx: BlockContext, p: Params): Record<string, unknown> {
   put("serial_number", p.SerialNumber);
   put("other_info", p.OtherInfo);
   put("timeout", p.Timeout);
-  put("file", p.File !== undefined ? ctx.resources.resolve(p.File) : undefined);
+  put("file", p.File !== undefined ? resolveFile(ctx, p.File) : undefined);
   return {
     board: p.Board,
     library: p.Library,
@@ -154,6 +160,15 @@ function moduleParams(ctx: BlockContext, p: Params): Record<string, unknown> {
     retry: p.Retry,
     log_level: p.LogLevel,
   };
+}
+
+/** The playback file's full path (a confined host refuses one outside its folders). */
+function resolveFile(ctx: BlockContext, file: string): string {
+  try {
+    return ctx.resources.resolve(file);
+  } catch (e) {
+    throw new BlockConfigError(e instanceof Error ? e.message : String(e), "File");
+  }
 }
 
 /** "CYTON_BOARD on /dev/ttyUSB0", for messages. */
