@@ -433,6 +433,13 @@ const SETUPS: Record<string, Setup | Setup[]> = {
     pattern: [0, 1, 1, 2, 0, 2],
   },
   Sink: { params: {}, inputs: [vec(2), timer(10)], pattern: [0, 1, 1], silent: true },
+  // Without a file host (openWrite) it says so and records nothing (tests/integration/xdf.test.ts).
+  XdfRecorder: {
+    params: { File: "rec.xdf" },
+    inputs: [vec(2), mat(2, 2)],
+    pattern: [0, 1, 1, 0],
+    silent: true,
+  },
   ControlAlgorithm: {
     params: { Strategy: "stepwise", SlewRate: 50, Timeout: 0 },
     inputs: [vec(3)],
@@ -484,6 +491,15 @@ const SETUPS: Record<string, Setup | Setup[]> = {
     { params: { Probes: [1] }, inputs: [timer(2000)] },
   ],
   Delsys: { params: { Sensors: 4 }, inputs: [timer(1926)] },
+  // Without a TCP bridge it says so and sends nothing (tests/integration/quattrocento.test.ts streams it).
+  Quattrocento: [
+    { params: {}, inputs: [], silent: true },
+    {
+      params: { Connectors: ["IN1", "AUX IN"], Select: [1, 17], Unit: "raw" },
+      inputs: [],
+      silent: true,
+    },
+  ],
   DLR_ADCBT: { params: { Port: "COM5", Channels: 3 }, inputs: [timer(100)] },
   NilsPod: { params: {}, inputs: [timer(100)] },
   ImuSimulator: [

@@ -26,6 +26,7 @@ interface Figure {
 export function targets(results: WorkloadResult[]): TargetRow[] {
   return [
     ...cpuRows(results),
+    recordingCostRow(results),
     memoryRow(results),
     ...timerRows(results),
     precisionRow(results),
@@ -136,6 +137,38 @@ function cpuRows(results: WorkloadResult[]): TargetRow[] {
       why(r, id),
     );
   });
+}
+
+/**
+ * What recording costs: the HD-EMG pipeline with an XdfRecorder on its 256 channels (hdemg-xdf)
+ * less the same pipeline without (hdemg), medians of one run each.
+ */
+function recordingCostRow(results: WorkloadResult[]): TargetRow {
+  const withRec = find(results, "pipeline", "hdemg-xdf");
+  const without = find(results, "pipeline", "hdemg");
+  const a = withRec?.ok ? withRec.cpu : null;
+  const b = without?.ok ? without.cpu : null;
+  return judged(
+    {
+      id: "cpu-xdf-recording",
+      workload:
+        "Recording 256 ch @ 2048 Hz to XDF (float32, 2 MiB/s), on top of the HD-EMG pipeline",
+      metric: "CPU, hdemg-xdf median − hdemg median (% of one core)",
+      paper: "not reported",
+      target: "≤ 2 % of one core",
+      limit: 2,
+      sense: "max",
+      unit: "% of one core",
+    },
+    a && b
+      ? {
+          value: a.medianPct - b.medianPct,
+          note: `hdemg-xdf ${fmtPct(a.medianPct)}, hdemg ${fmtPct(b.medianPct)} (medians of 1-s samples, one run each)`,
+        }
+      : null,
+    fmtPct,
+    why(withRec, "hdemg-xdf") || why(without, "hdemg"),
+  );
 }
 
 /** The spread of the CPU samples, the tick-based reading and the wake-up floor. */

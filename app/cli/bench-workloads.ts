@@ -131,6 +131,15 @@ export const WORKLOADS: WorkloadDef[] = [
   },
   {
     kind: "pipeline",
+    id: "hdemg-xdf",
+    title:
+      "(c+) High-density EMG recorded to XDF — 256 ch @ 2048 Hz, the raw grid as float32 (2 MiB/s)",
+    file: "hdemg-xdf.yaml",
+    acquisition: "HDEMG",
+    udpRateHz: HDEMG_25,
+  },
+  {
+    kind: "pipeline",
     id: "hdemg-features",
     title: "(d) High-density EMG features — 256 ch @ 2048 Hz, 200 ms windows every 25 ms",
     file: "hdemg-features.yaml",

@@ -4,7 +4,7 @@
  * stream headers, markers, the 0.1-s write cadence (also when only markers arrive), file names,
  * start/stop, failures.
  */
-import { describe, expect, test } from "vitest";
+import { beforeAll, describe, expect, test } from "vitest";
 import { catalog } from "../catalog";
 import {
   formatDiagnostic,
@@ -18,6 +18,9 @@ import {
 import { noResources, runVirtualPipeline } from "../../engine/testing";
 import { bytesSource, readXdf, xmlField, type XdfFile } from "./xdf-reader";
 import { MemoryFile } from "./xdf-testing";
+import { initDspForTests } from "../../../tests/support/wasm";
+
+beforeAll(() => initDspForTests());
 
 /** Files in memory; `openWrite` refuses an existing name as the Node host does. */
 class MemoryFiles {
@@ -83,6 +86,22 @@ async function loadError(yaml: string): Promise<string> {
 }
 
 describe("XdfRecorder", () => {
+  test("channel labels and unit come from the source's port meta, through same-shape blocks", async () => {
+    const files = new MemoryFiles();
+    await runVirtualPipeline(
+      `
+Amp: { Type: Quattrocento, Params: { Connectors: [IN1] } }
+Abs: { Type: Function, Inputs: [Amp], Params: { Operation: abs } }
+Rec: { Type: XdfRecorder, Inputs: [Abs], Params: { File: meta.xdf } }
+`,
+      { catalog, duration: 0.2, start: START, resources: files.resources() },
+    );
+    const [abs] = files.read("meta.xdf").streams;
+    expect(abs!.header.labels.slice(0, 3)).toEqual(["IN1/1", "IN1/2", "IN1/3"]);
+    expect(abs!.header.labels).toHaveLength(16);
+    expect(xmlField(abs!.header.xml, "unit")).toBe("mV");
+  });
+
   test("records signals (double64: exact) and Trigger markers with their timestamps", async () => {
     const files = new MemoryFiles();
     const run = await runVirtualPipeline(

@@ -16,8 +16,14 @@ export const streamSettings = z.strictObject({
     .describe(
       "Content type, e.g. EMG, EEG, Markers (default: Markers for events, else the source block's type)",
     ),
-  Labels: z.array(z.string()).optional().describe("One label per channel (default ch1, ch2, …)"),
-  Unit: z.string().optional().describe("Unit of every channel, e.g. microvolts"),
+  Labels: z
+    .array(z.string())
+    .optional()
+    .describe("One label per channel (default: the source's channel names, else ch1, ch2, …)"),
+  Unit: z
+    .string()
+    .optional()
+    .describe("Unit of every channel, e.g. microvolts (default: the source's, if it says)"),
   Format: z
     .enum(["float32", "double64", "string"])
     .optional()
@@ -101,8 +107,15 @@ function planStream(
       );
     }
     labels = [...s.Labels];
+  } else if (marker) {
+    labels = [name];
   } else {
-    labels = marker ? [name] : Array.from({ length: channels }, (_, k) => `ch${k + 1}`);
+    // The source's own channel names (PortMeta) when it gives them, else ch1, ch2, …
+    const known = info.meta?.labels;
+    labels =
+      known?.length === channels
+        ? [...known]
+        : Array.from({ length: channels }, (_, k) => `ch${k + 1}`);
   }
   return {
     name,
@@ -112,7 +125,7 @@ function planStream(
     format: fmt,
     sourceId: `MOSAIC/${ctx.name}/${info.source}`,
     labels,
-    unit: s.Unit ?? "",
+    unit: s.Unit ?? (marker ? "" : (info.meta?.unit ?? "")),
     hostname: "",
     size,
   };
