@@ -1,6 +1,13 @@
 import { describe, expect, test } from "vitest";
-import { catalog } from "../catalog";
-import { vectorShape, type FileWriteHandle, type Resources } from "../../engine";
+import { z } from "zod";
+import { BLOCKS, catalog } from "../catalog";
+import {
+  createCatalog,
+  defineBlock,
+  vectorShape,
+  type FileWriteHandle,
+  type Resources,
+} from "../../engine";
 import { BlockHarness, noResources, runVirtualPipeline } from "../../engine/testing";
 import { vectors } from "../../../tests/support/blocks";
 import { EdfRecorder } from "./edf-recorder";
@@ -93,6 +100,33 @@ function readWhole(b: Uint8Array): Read {
 }
 
 const T0 = Date.UTC(2026, 10, 24, 10, 0, 0) / 1000 + 0.25;
+
+/** A source that names its channels and their unit (PortMeta), as a device block does. */
+const Named = defineBlock({
+  type: "NamedSource",
+  category: "Testing",
+  summary: "Test source with channel names.",
+  help: "Emits [1, 2] per tick with labelled channels.",
+  params: z.strictObject({}),
+  inputs: { min: 1, max: 1 },
+  create(ctx) {
+    const out = ctx.output(vectorShape(2), undefined, {
+      labels: ["Biceps", "Triceps long head (EMG)"],
+      unit: "mV",
+    });
+    return {
+      process(f) {
+        const o = out.frame(f.n);
+        for (let i = 0; i < f.n; i++) {
+          o.t[i] = f.t[i]!;
+          o.v[2 * i] = 1;
+          o.v[2 * i + 1] = 2;
+        }
+        out.emit(o);
+      },
+    };
+  },
+});
 
 describe("EdfRecorder", () => {
   test("two inputs of different rates: exact digital values, labels, rates, time-keeping TALs", async () => {
@@ -239,6 +273,31 @@ Rec: { Type: EdfRecorder, Inputs: [Sin, Trig.label], Params: { File: "{block}-{d
     expect(rec.text).toMatch(
       /^Rec-20260921-141320\.edf: 1\.5 s, 4\.\d KiB, 3 records, 0 clipped, 2 annotations$/,
     );
+  });
+
+  test("labels and dimension from the channel names and unit the source block gives", async () => {
+    const m = memoryFiles();
+    await runVirtualPipeline(
+      `
+Timer: { Type: ScheduledTimer, DesiredRate: 100 }
+Arm: { Type: NamedSource, Inputs: [Timer] }
+Sin: { Type: SinGenerator, Inputs: [Timer] }
+Rec: { Type: EdfRecorder, Inputs: [Arm, Sin], Params: { File: named, RecordDuration: 0.1 } }
+`,
+      {
+        catalog: createCatalog([...BLOCKS, Named]),
+        duration: 0.5,
+        start: T0,
+        resources: m.resources,
+      },
+    );
+    const r = readWhole(m.bytes("named.edf"));
+    expect(r.header.signals.map((s) => [s.label, s.dimension])).toEqual([
+      ["Biceps", "mV"],
+      ["Triceps long hea", "mV"],
+      ["Sin", "uV"],
+      ["EDF Annotations", ""],
+    ]);
   });
 
   test("the File pattern never overwrites: -2, -3; start/stop make new files", async () => {

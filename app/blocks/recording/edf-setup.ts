@@ -179,17 +179,9 @@ function signalSlots(ctx: BlockContext, markers: readonly MarkerSlot[]): SignalS
   return slots;
 }
 
-/**
- * What the source block says of its channels (names, unit), where the engine passes it on
- * (`InputInfo.meta`); read structurally so that an engine without it gives undefined.
- */
-function channelMeta(i: InputInfo): { labels?: readonly string[]; unit?: string } | undefined {
-  return (i as { meta?: { labels?: readonly string[]; unit?: string } }).meta;
-}
-
 /** The source's name for channel `c` of `channels` (its first row's, for a matrix). */
 function metaLabel(i: InputInfo, c: number, channels: number): string | undefined {
-  const labels = channelMeta(i)?.labels;
+  const labels = i.meta?.labels;
   if (labels === undefined || labels.length < channels) return undefined;
   return labels[c];
 }
@@ -272,7 +264,7 @@ function streamInputs(
 /** One Dimension for all, else the source's unit (8 characters), else uV. */
 function dimensionOf(i: InputInfo, given: EdfParams["Dimension"]): string {
   if (typeof given === "string") return toAscii(given);
-  const unit = channelMeta(i)?.unit;
+  const unit = i.meta?.unit;
   return unit !== undefined && toAscii(unit).length <= 8 ? toAscii(unit) : "uV";
 }
 
