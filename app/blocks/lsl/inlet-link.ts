@@ -133,10 +133,21 @@ export class InletLink {
     });
     this.refused = "";
     this.stream = stream;
+    this.checkRate(stream);
     if (this.lost > 0) this.recovered++;
     this.state = "clock";
     this.clockWaitFrom = now;
     this.lastCorrection = Number.NEGATIVE_INFINITY;
+  }
+
+  /** Warns when the stream's nominal rate is not the block's DesiredRate (what downstream assumes). */
+  private checkRate(s: LslStreamInfo): void {
+    const want = this.ctx.desiredRate;
+    if (want > 0 && s.rate > 0 && Math.abs(want - s.rate) > 1e-6 * s.rate) {
+      this.ctx.warn(
+        `stream '${s.name}' has a nominal rate of ${s.rate} Hz; this block's DesiredRate is ${want} Hz`,
+      );
+    }
   }
 
   /** True when the stream can feed this block; otherwise says why in `refused`. */
@@ -183,7 +194,9 @@ export class InletLink {
     }
     this.state = "streaming";
     this.lastSampleAt = now;
-    for (const h of this.held.splice(0)) this.deliver(h.n, h.values, h.strings, h.remote, now);
+    // Held samples waited for the clock, not for the network: they stay out of the latency.
+    for (const h of this.held.splice(0))
+      this.deliver(h.n, h.values, h.strings, h.remote, now, false);
   }
 
   private streamStep(now: number): void {
@@ -260,13 +273,14 @@ export class InletLink {
     strings: string[] | undefined,
     remote: Float64Array,
     now: number,
+    timed = true,
   ): void {
     const times = this.times.length >= n ? this.times : (this.times = new Float64Array(n));
     for (let i = 0; i < n; i++)
       times[i] = senderToPipeline(remote[i]!, this.correction, this.clock);
     this.samples += n;
     this.chunks++;
-    this.latency.add(now - times[n - 1]!);
+    if (timed) this.latency.add(now - times[n - 1]!);
     this.o.onSamples(n, values, strings, times);
   }
 

@@ -57,7 +57,9 @@ export const LslInlet = defineBlock({
     "or a regular stream silent for 1 s or 20 periods) and recovered (liblsl reconnects to a " +
     "stream with a source id; others are resolved again). A stream with another channel count " +
     "or a string stream is refused with the reason. Uses liblsl through the host; unavailable in " +
-    "the browser build (the status says so). Meant for real time: under the virtual clock, " +
+    "the browser build (the status says so). Write `DesiredRate` as the stream's nominal rate: " +
+    "downstream blocks (filters, windows) take it from there, and a stream of another nominal " +
+    "rate is warned about. Meant for real time: under the virtual clock, " +
     "samples are stamped with LSL times shifted to the virtual start.",
   params,
   inputs: { min: 0, max: 0 },
@@ -80,15 +82,12 @@ export const LslInlet = defineBlock({
         out.emit(f);
       },
     });
-    const timer = ctx.every(
-      p.PollRate,
-      (times, n) => {
-        const now = times[n - 1]!;
-        link.poll(now);
-        if (throttle.due(now)) ctx.setText(link.text());
-      },
-      { catchUp: "skip" },
-    );
+    // Every due tick in one call (a stall is not a skipped tick: the block is not behind).
+    const timer = ctx.every(p.PollRate, (times, n) => {
+      const now = times[n - 1]!;
+      link.poll(now);
+      if (throttle.due(now)) ctx.setText(link.text());
+    });
     return {
       start() {
         const lsl = lslBridge(ctx);

@@ -77,15 +77,12 @@ export const LslMarkerInlet = defineBlock({
       if (unmapped > 0) s += `, ${unmapped} not a label or number (NaN)`;
       ctx.setText(s);
     };
-    const timer = ctx.every(
-      p.PollRate,
-      (times, n) => {
-        const now = times[n - 1]!;
-        link.poll(now);
-        if (throttle.due(now)) describe();
-      },
-      { catchUp: "skip" },
-    );
+    // Every due tick in one call (a stall is not a skipped tick: the block is not behind).
+    const timer = ctx.every(p.PollRate, (times, n) => {
+      const now = times[n - 1]!;
+      link.poll(now);
+      if (throttle.due(now)) describe();
+    });
     return {
       start() {
         const lsl = lslBridge(ctx);
