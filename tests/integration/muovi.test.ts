@@ -9,7 +9,7 @@
  * MuoviSingleProbe pipeline.
  */
 import { readFileSync, writeFileSync } from "node:fs";
-import { createServer } from "node:net";
+import { connect, createServer } from "node:net";
 import { join } from "node:path";
 import { createInterface } from "node:readline";
 import { afterEach, describe, expect, test } from "vitest";
@@ -314,6 +314,39 @@ describe("MuoviSingleProbe (the probe connects to this computer)", () => {
     cleanup.push(() => p.close());
     return p;
   }
+
+  test("a new connection replaces the current one: the old socket is closed, what it sent is dropped", async () => {
+    const port = await freePort();
+    const h = await harness(MuoviSingleProbe, { Probes: [0], Port: port }, 200);
+    h.start();
+    await until(() => /^waiting for a Muovi probe/.test(h.text), "listening");
+    // An old connection that sent half a sample and stays open.
+    const old = connect({ host: "127.0.0.1", port });
+    cleanup.push(() => void old.destroy());
+    let oldClosed = false;
+    old.on("data", () => {});
+    old.on("end", () => (oldClosed = true));
+    old.on("close", () => (oldClosed = true));
+    old.on("error", () => (oldClosed = true));
+    await new Promise<void>((r) => old.once("connect", () => r()));
+    await until(() => /connected; started it/.test(h.text), "the old connection started");
+    old.write(Buffer.alloc(10));
+    await sleep(50);
+    const p = await probe(port);
+    await until(() => oldClosed, "the old connection closed by the block");
+    await until(() => /^streaming 32 EMG channels/.test(h.text), "streaming from the new probe");
+    expect(h.warnings.join("\n")).toMatch(/was replaced by a new connection from 127\.0\.0\.1:/);
+    await until(() => p.samples >= 60, "60 samples sent");
+    await sleep(20);
+    const m = ticks(h, 1)[0]!;
+    let k0 = -1;
+    for (let k = 0; k <= p.samples && k0 < 0; k++) {
+      if (m[0] === muoviRaw(9, 0, 0, k) * 0.000286 && m[1] === muoviRaw(9, 0, 1, k) * 0.000286) {
+        k0 = k;
+      }
+    }
+    expect(k0).toBeGreaterThanOrEqual(0);
+  });
 
   test("listens, starts the probe with byte 9, matrices of exact mV; reconnection; stop byte 8", async () => {
     const port = await freePort();

@@ -202,8 +202,14 @@ export class MuoviProbeLink extends StreamLink {
   }
 
   private onPeer(remote: { host: string; port: number }, peer: TcpSocketHandle) {
-    // A new connection: the old one (if any) has ended; this one is current.
+    // A new connection replaces the current one (a probe that came back before the old
+    // connection timed out). The Node bridge ends the old one first (reported through its
+    // onClose); should a bridge not, the old socket is closed here and what it left is dropped.
     const gen = ++this.gen;
+    const old = this.peer;
+    this.peer = undefined;
+    old?.close();
+    this.endStream();
     this.peer = peer;
     this.peerName = remote.host.includes(":")
       ? `[${remote.host}]:${remote.port}`
