@@ -165,12 +165,22 @@ function sitePackages(root: string): string[] {
   return found;
 }
 
-/** Where liblsl is looked for, in order: MOSAIC_LIBLSL, then pylsl's copy in the sidecar's environment. */
+/**
+ * Where liblsl is looked for, in order: MOSAIC_LIBLSL alone when set; else pylsl's copy in the
+ * sidecar's environment (below the repository, or the app's resources), then the desktop app's
+ * `resources/liblsl/`.
+ */
 export function liblslCandidates(env: NodeJS.ProcessEnv = process.env): string[] {
   const own = env.MOSAIC_LIBLSL;
   if (own) return [own];
   const name = LIB_NAMES[process.platform] ?? "liblsl.so";
-  return repoRoots().flatMap((r) => sitePackages(r).map((s) => join(s, "pylsl", "lib", name)));
+  const found = repoRoots().flatMap((r) =>
+    sitePackages(r).map((s) => join(s, "pylsl", "lib", name)),
+  );
+  // The desktop app: a copy packaged beside its resources (electron-builder's extraResources).
+  const resources = (process as { resourcesPath?: string }).resourcesPath;
+  if (resources) found.push(join(resources, "liblsl", name));
+  return found;
 }
 
 /** The message for a library that is not there. */
