@@ -1,5 +1,12 @@
 import { z } from "zod";
-import { defineBlock } from "../../engine";
+import {
+  BlockConfigError,
+  defineBlock,
+  errorMessage,
+  type ElectrodeGrid,
+  type PortMeta,
+} from "../../engine";
+import { electrodeGrid, gridParam } from "./electrode-arrays";
 import {
   mvPerBit,
   SESSANTAQUATTRO_CHANNELS,
@@ -67,6 +74,7 @@ const params = z.strictObject({
       "mV (bioelectrical: 286 nV per bit; AUX: 146.48 µV per bit at 16 bits, 572.2 nV at " +
         "24; IMU and accessory channels as sent) or the raw integers",
     ),
+  Grid: gridParam(),
   Extras: z
     .boolean()
     .default(true)
@@ -101,6 +109,23 @@ export function sessantaquattroOutputs(p: Params): { name: string; scale: number
 function unitOf(name: string, p: Params): string {
   if (p.Unit === "raw") return p.HighRes ? "int24" : "int16";
   return /^(EMG|AUX)/.test(name) ? "mV" : "as sent";
+}
+
+/** Labels (the channels' names), the unit when every channel has the same, and the array. */
+function outputMeta(outs: readonly { name: string }[], p: Params): PortMeta {
+  let grid: ElectrodeGrid | undefined;
+  try {
+    grid = electrodeGrid(p.Grid, outs.length);
+  } catch (e) {
+    throw new BlockConfigError(errorMessage(e), "Grid");
+  }
+  const units = new Set(outs.map((c) => unitOf(c.name, p)));
+  const unit = units.size === 1 ? [...units][0]! : undefined;
+  return {
+    labels: outs.map((c) => c.name),
+    ...(unit !== undefined && unit !== "as sent" ? { unit } : {}),
+    ...(grid ? { grid } : {}),
+  };
 }
 
 export const Sessantaquattro = defineBlock({
@@ -164,6 +189,7 @@ export const Sessantaquattro = defineBlock({
     const o = { host: p.Host, port: p.Port, config };
     const instance = nativeStreamSource<Int32Array>(ctx, {
       rate: p.Rate,
+      meta: outputMeta(outs, p),
       maxLead: 0.05,
       channels: outs.length,
       target: sessantaquattroTarget(p.Model, p.Port),
