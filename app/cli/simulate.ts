@@ -14,6 +14,15 @@ import {
 } from "../devices/trigno-simulator";
 import { dlrAdcBtSimulatorOptions, startDlrAdcBtSimulator } from "../devices/dlr-adcbt-simulator";
 import {
+  hannesDongleSimulatorOptions,
+  startHannesDongleSimulator,
+} from "../devices/hannes-dongle-simulator";
+import { HannesEmgSimulator, hannesEmgSimulatorOptions } from "../devices/hannes-emg-simulator";
+import {
+  hannesGuiSimulatorOptions,
+  startHannesGuiSimulator,
+} from "../devices/hannes-gui-simulator";
+import {
   MuoviProbeSimulator,
   muoviProbeSimulatorOptions,
   SyncStationSimulator,
@@ -141,6 +150,69 @@ export const SIMULATORS: Record<string, DeviceSimulator> = {
           `DLR ADC/BT simulator on ${sim.path}: waits for the channel count and start, then streams ` +
             `${sim.rate} frames/s (${sim.channels} channels until told otherwise), seed ${sim.seed}`,
           "Point DLR_ADCBT's Port at the other end of the pty pair. Ctrl-C stops it.",
+        ],
+        close: () => sim.close(),
+      };
+    },
+  },
+  hannes: {
+    summary:
+      "IIT Rehab Dongle with a Hannes hand on a serial device (one end of a socat pty pair): answers $$$, scan, con N and dct, ACKs the hand's packets and prints its hand, wrist and thumb references",
+    usage: "--port PATH [--names NAME,NAME] [--verbose]",
+    options: {
+      port: { type: "string" },
+      names: { type: "string" },
+      verbose: { type: "boolean", default: false },
+    },
+    async start(v, log) {
+      const sim = await startHannesDongleSimulator({ ...hannesDongleSimulatorOptions(v), log });
+      return {
+        lines: [
+          `Hannes simulator on ${sim.path}: a Rehab Dongle listing ${sim.devices.map((d) => `${d.name} (con ${d.con})`).join(", ")}; ` +
+            "it prints each step of the handshake and the hand's references as they change",
+          "Point HannesHand's Port at the other end of the pty pair. Ctrl-C stops it.",
+        ],
+        close: () => sim.close(),
+      };
+    },
+  },
+  "hannes-gui": {
+    summary:
+      "IIT's Hannes GUI (virtual arm, UDP 8889): decodes HannesGUI's activation, raw-EMG and ARV datagrams and prints the arm's state as it changes",
+    usage: "[--host ADDR] [--port P]",
+    options: {
+      host: { type: "string" },
+      port: { type: "string" },
+    },
+    async start(v, log) {
+      const sim = await startHannesGuiSimulator({ ...hannesGuiSimulatorOptions(v), log });
+      return {
+        lines: [
+          `Hannes GUI simulator listening on UDP ${sim.host}:${sim.port}: prints hand, wrist P/S and wrist F/E activations, raw EMG and ARVs as they change`,
+          "Point HannesGUI's Host and Port there. Ctrl-C stops it.",
+        ],
+        close: () => sim.close(),
+      };
+    },
+  },
+  "hannes-emg": {
+    summary:
+      "The Hannes's EMG stream: sends UDP datagrams of 16-bit values (deterministic) to a HannesReceiver's HOST:PORT",
+    usage: "--to HOST:PORT [--rate HZ] [--channels N] [--count N]",
+    options: {
+      to: { type: "string" },
+      rate: { type: "string" },
+      channels: { type: "string" },
+      count: { type: "string" },
+    },
+    async start(v, log) {
+      const o = hannesEmgSimulatorOptions(v);
+      const sim = new HannesEmgSimulator({ ...o, log });
+      return {
+        lines: [
+          `Hannes EMG simulator sending to UDP ${sim.host}:${sim.port}: ${sim.channels} channels at ${sim.rate} Hz` +
+            (o.count !== undefined ? `, ${o.count} datagrams` : ""),
+          "Point HannesReceiver's Port there. Ctrl-C stops it.",
         ],
         close: () => sim.close(),
       };
@@ -280,7 +352,9 @@ export async function cmdSimulate(
     running = await sim.start(values as Values, (l) => out(`  ${l}`));
   } catch (e) {
     err(`mosaic simulate ${device}: ${(e as Error).message}`);
-    return (e as Error).message.includes("in use") ? 1 : 2;
+    // A device or port that is not available (missing, busy) is 1; a bad option 2.
+    const unavailable = (e as { exitCode?: unknown }).exitCode === 1;
+    return unavailable || (e as Error).message.includes("in use") ? 1 : 2;
   }
   for (const l of running.lines) out(l);
   await new Promise<void>((r) => {

@@ -43,6 +43,10 @@ export interface HannesDongleSimulator {
   readonly devices: readonly SimulatedHannes[];
   /** Everything received, in order, when `record` is on. */
   readonly records: readonly DongleRecord[];
+  /** The references of every SimultRefControl applied, in order, when `record` is on. */
+  readonly applied: readonly HandReference[];
+  /** Packets NACKed. */
+  readonly nacks: number;
   /** The hand connected now, if any. */
   readonly connected: SimulatedHannes | undefined;
   readonly handMode: "stream" | "command";
@@ -138,6 +142,12 @@ class Dongle implements HannesDongleSimulator {
   }
   get records(): readonly DongleRecord[] {
     return this.machine.records;
+  }
+  get applied(): readonly HandReference[] {
+    return this.machine.applied;
+  }
+  get nacks(): number {
+    return this.machine.nacks;
   }
   get connected(): SimulatedHannes | undefined {
     return this.machine.connected;

@@ -75,6 +75,11 @@ describe("the original's session", () => {
       expect(m.stateText()).toBe(
         "no hand connected: hand 0 · wrist P/S 0 · wrist F/E 80 · thumb 0 · 3 references",
       );
+      expect(m.applied).toEqual([
+        { hand: 42, ps: -50, fe: 75, thumb: 10 },
+        { hand: 100, ps: 100, fe: 0, thumb: -100 },
+        { hand: 0, ps: 0, fe: 80, thumb: 0 },
+      ]);
       expect(m.reference).toEqual({ hand: 0, ps: 0, fe: 80, thumb: 0 });
       expect([m.references, m.jointMask, m.controlMode, m.handMode]).toEqual([
         3,

@@ -159,6 +159,8 @@ export class HannesHandMachine {
   readonly devices: readonly SimulatedHannes[];
   /** Everything received, in order, when `record` is on. */
   readonly records: DongleRecord[] = [];
+  /** The references of every SimultRefControl applied, in order, when `record` is on. */
+  readonly applied: HandReference[] = [];
   readonly malformed: Record<DongleFault, number> = {
     unknownCommand: 0,
     badEnd: 0,
@@ -422,6 +424,7 @@ export class HannesHandMachine {
     }
     Object.assign(this.reference, { hand, ps, fe, thumb });
     this.references++;
+    if (this.o.record) this.applied.push({ hand, ps, fe, thumb });
     return undefined;
   }
 
