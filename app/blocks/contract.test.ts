@@ -433,6 +433,14 @@ const SETUPS: Record<string, Setup | Setup[]> = {
     pattern: [0, 1, 1, 2, 0, 2],
   },
   Sink: { params: {}, inputs: [vec(2), timer(10)], pattern: [0, 1, 1], silent: true },
+  // Without a file host (openWrite) it says so and records nothing (tests/integration/edf.test.ts);
+  // input 2 (aperiodic) is a marker input.
+  EdfRecorder: {
+    params: { File: "rec.edf" },
+    inputs: [vec(2), mat(2, 2), vec(1, 0)],
+    pattern: [0, 1, 1, 0, 2],
+    silent: true,
+  },
   // Without a file host (openWrite) it says so and records nothing (tests/integration/xdf.test.ts).
   XdfRecorder: {
     params: { File: "rec.xdf" },

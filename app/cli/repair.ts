@@ -10,18 +10,28 @@ import { parseArgs } from "node:util";
 import type { FileReadHandle } from "../engine/block";
 import { openFileRead } from "../host/file-read";
 import { openFileWrite } from "../host/file-write";
-import { planXdfRepair, type RepairPlan } from "../host/recording-repair";
+import { planEdfFileRepair, planXdfRepair, type RepairPlan } from "../host/recording-repair";
+
+/** Bytes to overwrite in what a repair keeps (a header field, such as EDF's record count). */
+interface Patch {
+  at: number;
+  bytes: Uint8Array;
+}
+
+type Plan = RepairPlan & { patches?: readonly Patch[] };
 
 export interface Repairer {
   /** The format's name, for messages. */
   format: string;
   /** Scans the file and says how to repair it; throws when it is not a file of this format. */
-  plan(src: FileReadHandle): RepairPlan;
+  plan(src: FileReadHandle): Plan;
 }
 
 /** Repairs by file extension (lower case, with the dot). */
 export const REPAIRS: Readonly<Record<string, Repairer>> = {
   ".xdf": { format: "XDF", plan: planXdfRepair },
+  ".edf": { format: "EDF+", plan: planEdfFileRepair },
+  ".bdf": { format: "BDF+", plan: planEdfFileRepair },
 };
 
 export function repairHelp(): string {
@@ -29,6 +39,8 @@ export function repairHelp(): string {
       Makes an interrupted recording readable and whole again (formats: ${Object.keys(REPAIRS).join(", ")}).
       XDF: a torn last chunk is dropped and every stream without a StreamFooter gets one (first
       and last timestamp, sample count, clock offsets), as LabRecorder writes it at the end.
+      EDF+/BDF+: a torn last data record is dropped and the header's number of data records is
+      set from the file's size (-1 or a stale count, as older or killed recorders leave it).
       By default the repaired file is written beside the original as NAME.repaired.EXT (an
       existing file is never overwritten) and the original is left as it is.
         --in-place  repair the file itself: cut the torn tail, append the footers
@@ -46,8 +58,8 @@ export function repairedName(file: string): string {
 
 const PIECE = 1 << 20;
 
-/** Writes the first `plan.keep` bytes of `src` and `plan.append` to a new file `out`. */
-function writeCopy(src: FileReadHandle, plan: RepairPlan, out: string): void {
+/** Writes the first `plan.keep` bytes of `src` (patched) and `plan.append` to a new file `out`. */
+function writeCopy(src: FileReadHandle, plan: Plan, out: string): void {
   const w = openFileWrite(out);
   try {
     const buf = new Uint8Array(PIECE);
@@ -59,19 +71,21 @@ function writeCopy(src: FileReadHandle, plan: RepairPlan, out: string): void {
       pos += n;
     }
     w.write(plan.append);
+    for (const p of plan.patches ?? []) w.writeAt(p.bytes, p.at);
     w.sync();
   } finally {
     w.close();
   }
 }
 
-/** Cuts `file` to `plan.keep` bytes and appends `plan.append`. */
-function writeInPlace(file: string, plan: RepairPlan): void {
+/** Cuts `file` to `plan.keep` bytes, applies `plan.patches` and appends `plan.append`. */
+function writeInPlace(file: string, plan: Plan): void {
   truncateSync(file, plan.keep);
-  const fd = openSync(file, "a");
+  const fd = openSync(file, "r+");
   try {
+    for (const p of plan.patches ?? []) writeSync(fd, p.bytes, 0, p.bytes.length, p.at);
     for (let done = 0; done < plan.append.length;) {
-      done += writeSync(fd, plan.append, done, plan.append.length - done);
+      done += writeSync(fd, plan.append, done, plan.append.length - done, plan.keep + done);
     }
     fdatasyncSync(fd);
   } finally {

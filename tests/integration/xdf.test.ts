@@ -274,7 +274,7 @@ describe("mosaic repair", () => {
     writeFileSync(join(dir, "a.txt"), "x");
     const unknown = runCli(["repair", join(dir, "a.txt")]);
     expect(unknown.code).toBe(2);
-    expect(unknown.stderr).toMatch(/unknown format '.txt' \(repairs: .xdf\)/);
+    expect(unknown.stderr).toMatch(/unknown format '.txt' \(repairs: .xdf, .edf, .bdf\)/);
     const none = runCli(["repair"]);
     expect(none.code).toBe(2);
     const notXdf = join(dir, "b.xdf");
