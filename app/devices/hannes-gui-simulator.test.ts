@@ -106,7 +106,7 @@ describe("on loopback UDP", () => {
     await sim.close();
     // The last state is printed (at most four lines a second, the last one always).
     expect(lines.at(-1)).toBe(sim.stateText());
-    expect(lines).toContain("malformed datagram: unknown kind: kind 7 (15, 16 and 32 known)");
+    expect(lines).toContain("malformed datagram 1: unknown kind: kind 7 (15, 16 and 32 known)");
   });
 
   test("a taken port: one error that says so (exit status 1 from the CLI)", async () => {

@@ -20,6 +20,7 @@ import {
   FRAME_START,
   hex,
   int8,
+  logsFault,
   numberOption,
   StateReporter,
   type SimulatorValues,
@@ -204,7 +205,9 @@ export class HannesGuiSimulator {
         break;
       case "malformed":
         this.malformed[d.fault]++;
-        this.log(`malformed datagram: ${FAULT_TEXT[d.fault]}: ${d.why}`);
+        if (logsFault(this.malformedTotal)) {
+          this.log(`malformed datagram ${this.malformedTotal}: ${FAULT_TEXT[d.fault]}: ${d.why}`);
+        }
         break;
     }
     this.reporter.update(this.stateText());

@@ -159,6 +159,20 @@ describe("refused and malformed input: counted, answered, never thrown", () => {
     expect(m.reference).toEqual({ hand: 0, ps: 0, fe: 0, thumb: 0 });
   });
 
+  test("a flood of garbage: every packet counted, the log limited, the next good one applied", () => {
+    const { m, log } = connected();
+    for (let i = 0; i < 500; i++) m.receive(Uint8Array.of(0x25, 0x63, 0x26, 0x0d, 0x0a));
+    m.receive(Uint8Array.from(pkt(0x1e, 0x00, 55, 0, 50, 0x00, 0x03, 0, 0, 0, 0)));
+    expect(m.malformed.unknownCommand).toBe(500);
+    expect(m.nacks).toBe(500);
+    expect(m.reference.hand).toBe(55);
+    const logged = log.filter((l) => l.startsWith("unknown command"));
+    expect(logged.length).toBe(15); // the first 10, then every 100th
+    expect(logged.at(-1)).toBe(
+      "unknown command: command 99 (25 63 26 0D 0A) [malformed input 500]",
+    );
+  });
+
   test("the dongle: unknown commands, con to nobody, dct with no hand, bytes with no hand", () => {
     const { m, replies, log } = machine();
     m.receive(Uint8Array.from(text("hello")));

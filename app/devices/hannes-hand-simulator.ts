@@ -17,7 +17,7 @@
  * thumb in stream mode ("for streaming joint position commands the Stream Mode has to be
  * activated", the original's comment). Malformed input is counted by kind and never throws.
  */
-import { FRAME_END, FRAME_START, hex, int8 } from "./hannes-simulator-common";
+import { FRAME_END, FRAME_START, hex, int8, logsFault } from "./hannes-simulator-common";
 
 /** The hand's command bytes that the original sent (its enum CommandParsing). */
 export const HAND_CMD = {
@@ -185,6 +185,8 @@ export class HannesHandMachine {
   nacks = 0;
 
   private buf = new Uint8Array(0);
+  /** Malformed inputs seen (each stray run once), for the log's limit. */
+  private faults = 0;
   private readonly log: (line: string) => void;
 
   constructor(private readonly o: HannesHandMachineOptions) {
@@ -450,7 +452,8 @@ export class HannesHandMachine {
     this.malformed[kind] += count;
     const error = `${FAULT_TEXT[kind]}: ${why}${bytes ? ` (${hex(bytes, 16)})` : ""}`;
     this.keep({ error });
-    this.log(error);
+    this.faults++;
+    if (logsFault(this.faults)) this.log(`${error} [malformed input ${this.faults}]`);
   }
 
   private reply(s: string): void {

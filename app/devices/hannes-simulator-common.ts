@@ -118,6 +118,12 @@ export class StateReporter {
   }
 }
 
+/**
+ * Whether the n-th malformed input (from 1) is printed: the first ten, then every hundredth, so
+ * that garbage (a wrong baud rate) does not flood the terminal; the state line counts them all.
+ */
+export const logsFault = (n: number): boolean => n <= 10 || n % 100 === 0;
+
 /** Bytes as hex ("25 1E 00 …"), at most `max` of them. */
 export function hex(b: ArrayLike<number>, max = 32): string {
   const n = Math.min(b.length, max);
