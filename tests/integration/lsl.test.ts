@@ -340,6 +340,29 @@ describe.runIf(available)(
       expect(inlet.output().v.at(-1)).toEqual([2, 2.5, -2, 0.25]);
     });
 
+    test("two streams match: the inlet says which it reads and how to choose", async () => {
+      const one = await harness(
+        LslOutlet,
+        { Name: "Twin", SourceId: "twin-1" },
+        { channels: 1, rate: 10 },
+      );
+      const two = await harness(
+        LslOutlet,
+        { Name: "Twin", SourceId: "twin-2" },
+        { channels: 1, rate: 10 },
+      );
+      one.start();
+      two.start();
+      await sleep(500);
+      const inlet = await harness(LslInlet, { Name: "Twin", Channels: 1 });
+      inlet.start();
+      poll(inlet);
+      await until(() => inlet.warnings.length > 0, "the warning", 15_000);
+      expect(inlet.warnings[0]).toMatch(
+        /^2 streams match name='Twin': reading the one on .* \(source id 'twin-[12]'\); narrow it with SourceId or a Predicate$/,
+      );
+    });
+
     test("without the bridge (the browser build) the blocks say so and nothing breaks", async () => {
       for (const [def, params, input] of [
         [LslOutlet, { Name: "X" }, { channels: 2, rate: 10 }],

@@ -18,6 +18,12 @@ import { CLOCK_CHECK_S, describeStream, ms } from "./lsl-common";
 
 /** How often the resolver's list is read while looking for the stream, s. */
 const RESOLVE_EVERY_S = 0.25;
+/**
+ * How long a new resolver looks before a stream is chosen, s: liblsl recommends resolving for
+ * 1 s, a shorter wait may list "only a subset (or none) of the outlets" (`resolver.h`), and the
+ * choice among several matches should see them all.
+ */
+const RESOLVE_SETTLE_S = 1;
 /** How often liblsl's time correction is read, s. */
 const CORRECTION_EVERY_S = 1;
 /** How long samples wait for the first time correction before they go out uncorrected, s. */
@@ -69,6 +75,7 @@ export class InletLink {
   private resolver: LslResolverHandle | undefined;
   private inlet: LslInletHandle | undefined;
   private lastResolve = Number.NEGATIVE_INFINITY;
+  private resolveFrom = Number.NaN;
   private lastCorrection = Number.NEGATIVE_INFINITY;
   private lastClockCheck = Number.NEGATIVE_INFINITY;
   private clockWaitFrom = 0;
@@ -122,11 +129,18 @@ export class InletLink {
 
   private resolveStep(now: number): void {
     if (!this.resolver || now - this.lastResolve < RESOLVE_EVERY_S) return;
+    if (Number.isNaN(this.resolveFrom)) this.resolveFrom = now;
+    if (now - this.resolveFrom < RESOLVE_SETTLE_S) return;
     this.lastResolve = now;
     const found = this.resolver.results();
     const usable = found.filter((s) => this.fits(s));
     if (usable.length === 0) return;
     const stream = usable[0]!;
+    if (usable.length > 1) {
+      this.ctx.warn(
+        `${usable.length} streams match ${this.o.predicate}: reading the one on ${stream.hostname ?? "?"} (source id '${stream.sourceId}'); narrow it with SourceId or a Predicate`,
+      );
+    }
     this.inlet = this.resolver.openInlet(stream, {
       bufferS: this.o.bufferS,
       recover: this.o.recover,

@@ -109,7 +109,7 @@ export const LslOutlet = defineBlock({
       const parts = [
         `streaming '${name}' (${describeStream(info)})`,
         `${formatCount(samples)} samples in ${formatCount(chunks)} chunks`,
-        link.outlet?.haveConsumers() ? "an inlet listens" : "no inlet yet",
+        link.outlet?.haveConsumers() ? "an inlet listens" : "no inlet connected",
       ];
       if (clamped > 0) parts.push(`${formatCount(clamped)} values clamped to ${p.Format}`);
       if (unsent > 0) parts.push(`${formatCount(unsent)} samples not sent (no outlet)`);
