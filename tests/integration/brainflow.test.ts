@@ -209,21 +209,36 @@ Board:
     );
   }, 120_000);
 
-  test("pipelines/devices/mindrove.yaml under --simulate-devices: BrainFlow's synthetic board stands in", () => {
+  test("pipelines/devices/mindrove.yaml under --simulate-devices: the synthetic board in the armband's 8 channels at 500 Hz", () => {
     requireBuild();
+    const dir = tempDir("mosaic-brainflow-");
+    const yaml = readFileSync(join(ROOT, "pipelines/devices/mindrove.yaml"), "utf8").replace(
+      "Type: BrainFlow\n",
+      "Type: BrainFlow\n  Path: armband.txt\n",
+    );
+    writeFileSync(join(dir, "mindrove.yaml"), yaml);
     const r = runCli(
-      ["run", "pipelines/devices/mindrove.yaml", "--simulate-devices", "--duration", "5", "--json"],
-      { timeoutMs: 90_000 },
+      ["run", join(dir, "mindrove.yaml"), "--simulate-devices", "--duration", "5", "--json"],
+      {
+        cwd: dir,
+        timeoutMs: 90_000,
+      },
     );
     expect(r.code, r.stderr).toBe(0);
     expect(r.stderr).toMatch(
-      /block 'Armband' \(BrainFlow\) simulated by BrainFlow's synthetic board in place of MINDROVE_WIFI_BOARD/,
+      /block 'Armband' \(BrainFlow\) simulated by BrainFlow's synthetic board in MINDROVE_WIFI_BOARD's channels and at its rate/,
     );
-    const tel = telemetry(r.stdout).at(-1)!;
-    const armband = tel.blocks.find((b) => b.name === "Armband")!;
-    expect(armband.text).toMatch(/^streaming from board SYNTHETIC_BOARD/);
-    expect(tel.blocks.find((b) => b.name === "Use")!.events).toBe(armband.events);
-    expect(armband.events).toBeGreaterThan(100); // streaming (the sidecar takes a second or two to start)
+    const summary = jsonLines(r.stdout).find((l) => l.type === "summary") as unknown as {
+      blocks: { name: string; desiredRate: number; events: number; text: string }[];
+    };
+    const armband = summary.blocks.find((b) => b.name === "Armband")!;
+    // The armband's shape and rate (mindrove 5.3.0: 8 EXG channels at 500 Hz), as on the device.
+    expect(armband.desiredRate).toBe(500);
+    const rows = logRows(join(dir, "armband.txt"));
+    expect(rows.length).toBeGreaterThan(100); // streaming (the sidecar takes a second or two to start)
+    expect(rows.every((row) => row.length === 1 + 8)).toBe(true);
+    expect(armband.text).toMatch(/BrainFlow's synthetic board as MINDROVE_WIFI_BOARD/);
+    expect(summary.blocks.find((b) => b.name === "Use")!.events).toBe(armband.events);
   }, 120_000);
 
   test("the sidecar killed mid-run: reported, restarted, the board streams again", async () => {

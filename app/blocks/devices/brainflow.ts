@@ -97,6 +97,13 @@ const params = z.strictObject({
     .describe(
       "BrainFlowInputParams.master_board: the board that recorded what the playback (or streaming) board plays",
     ),
+  Simulated: z
+    .boolean()
+    .default(false)
+    .describe(
+      "Read BrainFlow's synthetic board instead of the board, in the board's channels and at its rate " +
+        "(what --simulate-devices sets): no device is opened",
+    ),
   PollRate: z
     .number()
     .min(1)
@@ -156,6 +163,7 @@ function moduleParams(ctx: BlockContext, p: Params): Record<string, unknown> {
     input,
     ...(p.MasterBoard !== undefined ? { master_board: p.MasterBoard } : {}),
     poll_rate: p.PollRate,
+    simulated: p.Simulated,
     silence: p.Silence,
     retry: p.Retry,
     log_level: p.LogLevel,
@@ -173,6 +181,7 @@ function resolveFile(ctx: BlockContext, file: string): string {
 
 /** "CYTON_BOARD on /dev/ttyUSB0", for messages. */
 function targetOf(p: Params): string {
+  if (p.Simulated) return `BrainFlow's synthetic board as ${String(p.Board)}`;
   const where = p.SerialPort ?? p.IpAddress ?? p.MacAddress ?? p.File;
   return `board ${String(p.Board)}${where ? ` (${where})` : ""}`;
 }
@@ -219,7 +228,9 @@ export const BrainFlow = defineBlock({
     "prepared again; samples it held are lost). No simulator is needed: BrainFlow's synthetic " +
     "board (SYNTHETIC_BOARD) and playback board (PLAYBACK_FILE_BOARD with `File` and " +
     "`MasterBoard`, which plays a file written by DataFilter.write_file) are the simulators, " +
-    "and `--simulate-devices` runs the block on the synthetic board of its library; a playback " +
+    "and `--simulate-devices` sets `Simulated`: the synthetic board's signals (its 16 EXG " +
+    "channels cycled over the board's, accel, gyro) linearly interpolated from its 250 Hz to " +
+    "the board's channels and rate, so the pipeline keeps its shapes and rates; a playback " +
     "that reaches the end of its file finishes the run. The board runs in real time even " +
     "under the virtual clock (each poll is waited for, but a fast virtual run gets few samples: a " +
     "warning says so). Tested here on the synthetic and " +
@@ -228,7 +239,7 @@ export const BrainFlow = defineBlock({
   params,
   inputs: { min: 0, max: 0 },
   outputs: ["data"],
-  finite: (p) => isPlayback(p.Board),
+  finite: (p) => isPlayback(p.Board) && !p.Simulated,
   eventLoop: true,
   views: ["scope", "spider"],
   panel:
@@ -247,7 +258,7 @@ export const BrainFlow = defineBlock({
       };
     }
     const target = targetOf(p);
-    const playback = isPlayback(p.Board);
+    const playback = isPlayback(p.Board) && !p.Simulated;
     const counts: BoardCounts = { state: 0, lost: 0, reconnects: 0, failures: 0, total: 0 };
     const throttle = new TextThrottle(0.5);
     let emitted = 0;

@@ -158,44 +158,26 @@ const TRIGNO_NATIVE_RATE = 26 / 0.0135;
 /** Myo's EMG as the armband gives it: int8 / 128, filtered on board (no hum). */
 const MYO_EMG = { AmplitudeMv: 0.25, NoiseFloorMv: 0.005, HumMv: 0 };
 
-/** Channel kinds BrainFlow's synthetic board has (BoardShim.get_board_descr(SYNTHETIC_BOARD)). */
-const SYNTHETIC_KINDS = new Set([
-  "exg",
-  "emg",
-  "eeg",
-  "ecg",
-  "eog",
-  "accel",
-  "gyro",
-  "package",
-  "timestamp",
-]);
+/** BrainFlow's own simulators: a block on one of them is left as it is. */
+const BRAINFLOW_SIMULATORS = /^(synthetic(_board)?|playback(_file(_board)?)?|-1|-3)$/i;
 
-/** A BrainFlow block on BrainFlow's synthetic board: its kinds, poll rate and silence kept. */
-function brainflowSynthetic(b: BlockSpec): Replacement {
-  const kinds = ((p(b).Channels as string[] | undefined) ?? ["exg"]).filter((k) =>
-    SYNTHETIC_KINDS.has(k),
-  );
+/**
+ * A BrainFlow block on BrainFlow's synthetic board in the board's own layout and rate
+ * (`Simulated`: no device opened); its connection params are dropped.
+ */
+function brainflowSynthetic(b: BlockSpec): Replacement | string {
+  const board = String(p(b).Board).trim();
+  if (BRAINFLOW_SIMULATORS.test(board)) {
+    return `left as it is: board ${board} is one of BrainFlow's own simulators`;
+  }
   const keep = Object.fromEntries(
-    ["PollRate", "Silence", "Retry", "LogLevel"].flatMap((k) =>
+    ["Board", "Library", "Channels", "PollRate", "Silence", "Retry", "LogLevel"].flatMap((k) =>
       p(b)[k] !== undefined ? [[k, p(b)[k]]] : [],
     ),
   );
   return {
-    blocks: [
-      {
-        name: b.name,
-        type: "BrainFlow",
-        params: {
-          Board: "SYNTHETIC_BOARD",
-          Library: "brainflow",
-          Channels: kinds.length > 0 ? kinds : ["exg"],
-          ...keep,
-        },
-        inputs: [],
-      },
-    ],
-    summary: `BrainFlow's synthetic board in place of ${String(p(b).Board)} (16 EXG channels at 250 Hz, whatever the board's own count and rate)`,
+    blocks: [{ name: b.name, type: "BrainFlow", params: { ...keep, Simulated: true }, inputs: [] }],
+    summary: `BrainFlow's synthetic board in ${board}'s channels and at its rate (Simulated: true)`,
   };
 }
 
@@ -408,7 +390,7 @@ export const SIMULATED_DEVICES: Readonly<Record<string, DeviceRule>> = {
     kind: "source",
     network: false,
     becomes:
-      "the same BrainFlow block on BrainFlow's synthetic board (SYNTHETIC_BOARD: 16 EXG channels at 250 Hz, accel and gyro), its channel kinds kept where the synthetic board has them; needs the Python sidecar",
+      "the same BrainFlow block with Simulated: BrainFlow's synthetic board read in the board's channels and at its rate (its EXG, accel and gyro interpolated from 250 Hz); left as it is on the synthetic or playback board; needs the Python sidecar",
     substitute(b) {
       return brainflowSynthetic(b);
     },

@@ -26,7 +26,8 @@ input (BrainFlowInputParams fields), master_board (for the playback and streamin
 channels (kinds: exg, emg, eeg, ecg, eog, accel, gyro, magnetometer, package,
 timestamp), poll_rate (Hz: the
 result holds up to 4 polls' samples, at least 32; or max_rows), silence (s;
-0: never), buffer (BrainFlow's ring buffer, samples), log_level (BrainFlow's logger: 0 trace … 6
+0: never), buffer (BrainFlow's ring buffer, samples), simulated (BrainFlow's synthetic board in
+the board's layout and rate: Resampler), log_level (BrainFlow's logger: 0 trace … 6
 off), retry (a fixed wait between attempts, s, instead of the backoff; tests).
 """
 
@@ -151,6 +152,7 @@ def layout(shim: Any, bid: int, kinds: list[str]) -> dict:
     rows: list[int] = []
     names: list[str] = []
     counts: list[int] = []
+    column_kinds: list[str] = []
     for kind in kinds:
         if kind not in KINDS:
             raise ValueError(f"unknown channel kind '{kind}' (kinds: {', '.join(KINDS)})")
@@ -162,6 +164,7 @@ def layout(shim: Any, bid: int, kinds: list[str]) -> dict:
             raise ValueError(f"the board has no {kind} channels")
         rows += found
         counts.append(len(found))
+        column_kinds += [kind] * len(found)
         names += [f"{kind} {i + 1}" for i in range(len(found))]
     try:
         package = int(BoardShim.get_package_num_channel(bid))
@@ -171,6 +174,7 @@ def layout(shim: Any, bid: int, kinds: list[str]) -> dict:
         "rows": rows,
         "names": names,
         "counts": counts,
+        "kinds": column_kinds,
         "rate": float(BoardShim.get_sampling_rate(bid)),
         "package": package,
     }
@@ -207,6 +211,67 @@ def explain(e: Exception, target: str) -> str:
     return f"{text} ({hint})" if hint else text
 
 
+# BrainFlow's synthetic board (brainflow 5.23.0, BoardShim.get_board_descr(SYNTHETIC_BOARD)).
+SYNTHETIC = -1
+SYNTHETIC_RATE = 250.0
+SYNTHETIC_PACKAGE = 0
+SYNTHETIC_ROWS = {
+    "exg": list(range(1, 17)),
+    "accel": [17, 18, 19],
+    "gyro": [20, 21, 22],
+    "timestamp": [30],
+}
+# Kinds the synthetic board has no rows of take these (magnetometer: the accelerometer's).
+SYNTHETIC_STANDS_IN = {"emg": "exg", "eeg": "exg", "ecg": "exg", "eog": "exg", "magnetometer": "accel"}
+
+
+class Resampler:
+    """BrainFlow's synthetic board in another board's layout (`simulated`): each output column
+    takes a synthetic row of its kind (cycling through them: the 16 EXG rows, accel, gyro), the
+    package column counts 0…255, and the samples are linearly interpolated from the synthetic
+    board's 250 Hz to the board's rate."""
+
+    def __init__(self, board_layout: dict):
+        rows: list[int] = []
+        seen: dict[str, int] = {}
+        self.package_columns: list[int] = []
+        for col, kind in enumerate(board_layout["kinds"]):
+            if kind == "package":
+                self.package_columns.append(col)
+                rows.append(SYNTHETIC_PACKAGE)
+                continue
+            source = SYNTHETIC_ROWS[SYNTHETIC_STANDS_IN.get(kind, kind)]
+            k = seen.get(kind, 0)
+            seen[kind] = k + 1
+            rows.append(source[k % len(source)])
+        self.rows = rows
+        self.step = SYNTHETIC_RATE / float(board_layout["rate"])  # synthetic samples per output
+        self.restart()
+
+    def restart(self) -> None:
+        self.prev: np.ndarray | None = None
+        self.pos = 0.0  # the next output's position, in synthetic samples after `prev`
+        self.counter = 0
+
+    def convert(self, data: np.ndarray) -> np.ndarray:
+        """[output samples, columns] from a chunk of synthetic data [rows, samples]."""
+        x = data[self.rows].T
+        seq = x if self.prev is None else np.vstack((self.prev, x))
+        last = seq.shape[0] - 1
+        at = np.arange(self.pos, last + 1e-9, self.step) if last >= 0 else np.empty(0)
+        i0 = np.floor(at).astype(int)
+        i1 = np.minimum(i0 + 1, last)
+        frac = (at - i0)[:, np.newaxis]
+        out = seq[i0] * (1.0 - frac) + seq[i1] * frac
+        n = out.shape[0]
+        for col in self.package_columns:
+            out[:, col] = (self.counter + np.arange(n)) % 256
+        self.counter = (self.counter + n) % 256
+        self.pos = (at[-1] + self.step if n else self.pos) - last
+        self.prev = seq[-1:].copy()
+        return np.ascontiguousarray(out)
+
+
 class Reader:
     """The board's session, run by a thread: prepare, stream, read, retry."""
 
@@ -230,6 +295,9 @@ class Reader:
         if self.playback and not os.path.isfile(self.inputs.file):
             given = self.inputs.file
             raise ValueError(f"the playback file {given} does not exist" if given else "the playback board needs a playback file")
+        self.simulated: Resampler | None = None
+        if params.get("simulated"):
+            self.simulated = Resampler(self.layout)
         poll_rate = float(params.get("poll_rate", 50))
         self.max_rows = int(params.get("max_rows") or max(32, math.ceil(4 * self.layout["rate"] / poll_rate)))
         self.width = max(HEADER, len(self.layout["rows"]))
@@ -242,6 +310,8 @@ class Reader:
             "",
         )
         self.target = f"{self.lib} board {board}" + (f" on {where}" if where else "")
+        if self.simulated:
+            self.target = f"BrainFlow's synthetic board as {self.lib} board {board}"
         self.queue: collections.deque[np.ndarray] = collections.deque()
         self.lock = threading.Lock()
         self.state = IDLE
@@ -281,12 +351,14 @@ class Reader:
         self.state = STOPPED
         with self.lock:  # a later start begins a new stream
             self.queue.clear()
+        if self.simulated:
+            self.simulated.restart()
         self.last_package = None
 
     def run(self) -> None:
         while not self.stopping.is_set():
             self.state = CONNECTING
-            shim = self.shim.BoardShim(self.board, self.inputs)
+            shim = self.open_board()
             try:
                 shim.prepare_session()
                 shim.start_stream(self.buffer)
@@ -302,6 +374,14 @@ class Reader:
                 self.stopping.wait()
             elif reason:
                 self.fail(f"{self.target}: {reason}")
+
+    def open_board(self) -> Any:
+        """The board's BoardShim, or BrainFlow's synthetic board when simulated."""
+        if self.simulated:
+            shim, params_class = library("brainflow")
+            shim.BoardShim.set_log_level(self.log_level)
+            return shim.BoardShim(SYNTHETIC, params_class())
+        return self.shim.BoardShim(self.board, self.inputs)
 
     def stream(self, shim: Any) -> str | None:
         """Reads until stopped (None), the data stops (a reason) or a playback file ends."""
@@ -339,10 +419,16 @@ class Reader:
         self.state = STREAMING
 
     def take(self, data: np.ndarray) -> None:
-        package = self.layout["package"]
-        if package >= 0:
-            self.count_gaps(data[package])
-        chunk = np.ascontiguousarray(data[self.layout["rows"]].T)
+        if self.simulated:
+            self.count_gaps(data[SYNTHETIC_PACKAGE])
+            chunk = self.simulated.convert(data)
+            if chunk.shape[0] == 0:
+                return
+        else:
+            package = self.layout["package"]
+            if package >= 0:
+                self.count_gaps(data[package])
+            chunk = np.ascontiguousarray(data[self.layout["rows"]].T)
         with self.lock:
             self.queue.append(chunk)
             self.total += chunk.shape[0]

@@ -152,3 +152,41 @@ def test_stop_then_poll_starts_a_new_stream():
     finally:
         B.poll(STOP, state)
     assert len(first) > 0 and len(again) > 0 and header[B.H_STATE] == B.STREAMING
+
+
+def test_resampler_interpolates_the_synthetic_board_into_another_layout():
+    # A layout of 2 EMG channels, accel x and the package number at 500 Hz (twice the synthetic's
+    # 250): each output column takes its kind's synthetic row, the package column counts.
+    r = B.Resampler({"kinds": ["emg", "emg", "accel", "package"], "rate": 500.0})
+    assert r.rows == [1, 2, 17, 0]
+    data = np.zeros((32, 6))
+    data[1] = [0, 2, 4, 6, 8, 10]
+    data[2] = 100 + data[1]
+    data[17] = [0, 1, 0, 1, 0, 1]
+    chunks = [r.convert(data[:, :2]), r.convert(data[:, 2:5]), r.convert(data[:, 5:])]
+    out = np.concatenate(chunks)
+    # 6 synthetic samples span 5 intervals: 11 output samples at twice the rate, whatever the chunks.
+    assert out.shape == (11, 4)
+    assert np.array_equal(out[:, 0], np.arange(11.0))
+    assert np.array_equal(out[:, 1], 100 + np.arange(11.0))
+    assert np.array_equal(out[:, 2], [0, 0.5, 1, 0.5, 0, 0.5, 1, 0.5, 0, 0.5, 1])
+    assert np.array_equal(out[:, 3], np.arange(11.0))
+    # Down to 125 Hz: every other synthetic sample.
+    down = B.Resampler({"kinds": ["exg"], "rate": 125.0})
+    assert np.array_equal(np.concatenate([down.convert(data[:, :3]), down.convert(data[:, 3:])])[:, 0], [0, 4, 8])
+
+
+def test_simulated_mindrove_has_its_shape_and_rate():
+    state = B.init({"board": "MINDROVE_WIFI_BOARD", "channels": ["exg", "package", "timestamp"], "simulated": True})
+    described = B.poll(DESCRIBE, state)[0]
+    assert described[B.H_RATE] == 500 and described[B.H_CHANNELS] == 10
+    try:
+        data, header = drain(state, 1.5)
+    finally:
+        B.poll(STOP, state)
+    assert np.all(np.diff(data[:, 8]) % 256 == 1)
+    # Twice the synthetic board's rate by its own arrival stamps (interpolated with the samples):
+    # 500 Hz, less what the synthetic board loses to its sleep per sample on a loaded machine.
+    ts = data[:, 9]
+    assert 0.8 * 500 < (len(data) - 1) / (ts[-1] - ts[0]) < 500 * 1.01
+    assert header[B.H_LOST] == 0
