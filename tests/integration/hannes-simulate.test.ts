@@ -52,18 +52,18 @@ async function waitFor(
 }
 
 /** A socat pty pair: `dev` for the pipeline, `dongle` for the simulator. */
-async function ptyPair(dir: string): Promise<void> {
-  children.push(
-    spawn("socat", [
-      `pty,raw,echo=0,link=${join(dir, "dev")}`,
-      `pty,raw,echo=0,link=${join(dir, "dongle")}`,
-    ]),
-  );
+async function ptyPair(dir: string): Promise<ChildProcess> {
+  const socat = spawn("socat", [
+    `pty,raw,echo=0,link=${join(dir, "dev")}`,
+    `pty,raw,echo=0,link=${join(dir, "dongle")}`,
+  ]);
+  children.push(socat);
   await waitFor(
     () => existsSync(join(dir, "dev")) && existsSync(join(dir, "dongle")),
     5000,
     "socat",
   );
+  return socat;
 }
 
 async function freePort(): Promise<number> {
@@ -191,6 +191,88 @@ hand: { Type: HannesHand, Inputs: [ control ], Params: { Port: ${JSON.stringify(
     expect(new Set(streamed.map((r) => JSON.stringify(r))).size).toBeGreaterThan(10);
     expect(sim.applied.at(-1)).toEqual({ hand: 0, ps: 0, fe: 80, thumb: 0 });
   }, 90_000);
+});
+
+describe.skipIf(!haveSocat)("HannesHand when the dongle is unplugged and plugged in again", () => {
+  test("reported, the port reopened, the handshake run again, the references exact", async () => {
+    requireBuild();
+    const dir = tempDir("mosaic-hannes-sim-");
+    let socat = await ptyPair(dir);
+    const dongle = () => startHannesDongleSimulator({ path: join(dir, "dongle"), record: true });
+    const first = await dongle();
+    closers.push(() => first.close());
+    const file = join(dir, "hand.yaml");
+    writeFileSync(
+      file,
+      `timer: { Type: ScheduledTimer, DesiredRate: 25 }
+predictions: { Type: SinGenerator, Inputs: [ timer ], Params: [ 12, 1, 0.5 ] }
+control: { Type: ControlAlgorithm, Inputs: [ predictions ], Params: [ algorithm:DirectControl ] }
+hand: { Type: HannesHand, Inputs: [ control ], Params: { Port: ${JSON.stringify(join(dir, "dev"))} }, Path: logs }
+`,
+    );
+    const run = runAsync(["run", file, "--duration", "60", "--json"]);
+    const last = (): string => statusTexts(run.out(), "hand").at(-1) ?? "";
+    await first.waitFor(() => first.references >= 25, "25 references", 30_000);
+
+    // The unplug: the pty pair disappears; the block says so and tries again every second.
+    socat.kill("SIGTERM");
+    await waitFor(
+      () => /^opening .*retrying every 1 s/.test(last()),
+      10_000,
+      () => `the unplug (${last()})`,
+    );
+    await first.close();
+    await waitFor(() => !existsSync(join(dir, "dev")), 5000, "socat's links removed");
+    const second = await (async () => {
+      socat = await ptyPair(dir);
+      return dongle();
+    })();
+    closers.push(() => second.close());
+    await second.waitFor(() => second.references >= 25, "25 references after the reopen", 30_000);
+    await waitFor(
+      () => /^Hannes on .*: [\d,]+ references sent/.test(last()),
+      5000,
+      () => `streaming (${last()})`,
+    );
+    run.child.kill("SIGINT");
+    expect(await run.done, run.out().slice(-2000)).toBe(0);
+    await second.waitFor(
+      () => second.records.some((r) => "text" in r && r.text === "dct"),
+      "dct",
+      5000,
+    );
+
+    // The whole handshake again on the new port, and the whole end.
+    for (const sim of [first, second]) {
+      expect(sim.records.slice(0, 7)).toEqual([
+        { text: "$$$" },
+        { text: "scan" },
+        { text: "con 1" },
+        { packet: [0] },
+        { packet: [14, 0, 0x64] },
+        { packet: [14, 5, 3] },
+        { packet: [1] },
+      ]);
+      expect(sim.malformedTotal).toBe(0);
+    }
+    expect(second.records.slice(-4)).toEqual([
+      { packet: [30, 0, 0, 0, 80, 0, 3, 0, 0, 0, 0] },
+      { packet: [0] },
+      { text: "$$$" },
+      { text: "dct" },
+    ]);
+    // The references the second dongle got are the block's last logged rows, exactly.
+    const streamed = second.applied.slice(0, -1);
+    const logged = readLog(join(dir, "logs", "hand.txt"));
+    expect(streamed).toEqual(
+      logged.slice(logged.length - streamed.length).map(([, hand, ps, fe, thumb]) => ({
+        hand: trunc(hand!),
+        ps: trunc(ps!),
+        fe: trunc(fe!),
+        thumb: trunc(thumb!),
+      })),
+    );
+  }, 120_000);
 });
 
 describe("HannesGUI and HannesReceiver against the UDP simulators", () => {
