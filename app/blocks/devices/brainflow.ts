@@ -4,21 +4,9 @@ import {
   defineBlock,
   vectorShape,
   type BlockContext,
-  type PythonCallError,
+  type BlockInstance,
 } from "../../engine";
-import { plural, TextThrottle } from "../shared/text";
-import { DeviceClock } from "./delsys-protocol";
-import {
-  BoardState,
-  CMD_POLL,
-  CMD_STOP,
-  H_N,
-  loadBoard,
-  readCounts,
-  stateText,
-  type BoardCounts,
-  type BoardLink,
-} from "./brainflow-link";
+import { BrainFlowRun } from "./brainflow-run";
 
 const boardName = z.union([z.string().trim().min(1).max(64), z.number().int().min(-100).max(999)]);
 
@@ -186,15 +174,23 @@ function targetOf(p: Params): string {
   return `board ${String(p.Board)}${where ? ` (${where})` : ""}`;
 }
 
-const WARN_EVERY_S = 5;
-
-const VIRTUAL_WARNING =
-  "BrainFlow boards run in real time: under the virtual clock this block emits what the board " +
-  "delivered by each poll, so a fast virtual run gets few samples; run it in real time";
-
 /** The playback board (the same id in brainflow and mindrove) plays a file to its end. */
 const isPlayback = (board: string | number): boolean =>
   board === -3 || /^playback(_file(_board)?)?$/i.test(String(board).trim());
+
+/** Without Python (the browser build): the block loads, says so and emits nothing. */
+function withoutPython(ctx: BlockContext): BlockInstance {
+  ctx.output(vectorShape(1), "data");
+  const text =
+    "BrainFlow needs Python (not available in the browser build): run the pipeline with mosaic run or the desktop app";
+  ctx.setText(text);
+  return {
+    start() {
+      ctx.setText(text);
+      ctx.warn(text);
+    },
+  };
+}
 
 export const BrainFlow = defineBlock({
   type: "BrainFlow",
@@ -245,212 +241,14 @@ export const BrainFlow = defineBlock({
   panel:
     "Scope of the channels; the board's state, samples, lost samples, reconnections, sidecar restarts.",
   async create(ctx, p) {
-    if (!ctx.io.python) {
-      ctx.output(vectorShape(1), "data");
-      const text =
-        "BrainFlow needs Python (not available in the browser build): run the pipeline with mosaic run or the desktop app";
-      ctx.setText(text);
-      return {
-        start() {
-          ctx.setText(text);
-          ctx.warn(text);
-        },
-      };
-    }
-    const target = targetOf(p);
-    const playback = isPlayback(p.Board) && !p.Simulated;
-    const counts: BoardCounts = { state: 0, lost: 0, reconnects: 0, failures: 0, total: 0 };
-    const throttle = new TextThrottle(0.5);
-    let emitted = 0;
-    let restarts = 0;
-    let lastFailure = "";
-    let sidecarDown = "";
-    let lastText = "";
-    let lastLost = 0;
-    let lastReconnects = 0;
-    let lastWarn = -Infinity;
-    let inFlight = false;
-    let running = false;
-    let finished = false;
-
-    const refresh = (): void => {
-      let text = sidecarDown || stateText(counts, target, lastFailure);
-      text += ` · ${plural(emitted, "sample")}`;
-      if (link?.sidecar.pid !== undefined) text += ` · pid ${link.sidecar.pid}`;
-      if (counts.lost > 0) text += ` · ${counts.lost} lost (package numbers)`;
-      if (counts.reconnects > 0) text += ` · reconnected ${counts.reconnects}×`;
-      if (restarts > 0) text += ` · sidecar restarted ${restarts}×`;
-      if (text !== lastText) {
-        lastText = text;
-        ctx.setText(text);
-      }
-    };
-
-    // Assigned once the sidecar is loaded (the handlers below are given to the load).
-    /* eslint-disable prefer-const */
-    let link: BoardLink | undefined;
-    let out: ReturnType<typeof ctx.output>;
-    let clock: DeviceClock;
-    /* eslint-enable prefer-const */
-
-    const awaiting = (): void => {
-      if (ctx.virtual) ctx.setAwaiting(inFlight ? 1 : 0);
-    };
-
-    const onResult = (values: Float64Array): void => {
-      inFlight = false;
-      awaiting();
-      const w = link!.width;
-      readCounts(values, counts);
-      if (counts.reconnects !== lastReconnects) {
-        lastReconnects = counts.reconnects;
-        clock.restart();
-        ctx.warn(`${target}: streaming again after a failure`);
-      }
-      if (counts.lost > lastLost) {
-        const now = ctx.now();
-        if (now - lastWarn >= WARN_EVERY_S) {
-          lastWarn = now;
-          ctx.warn(
-            `${target}: ${counts.lost - lastLost} samples lost (gaps in its package numbers)`,
-          );
-        }
-        lastLost = counts.lost;
-      }
-      const n = values[H_N]!;
-      if (n > 0 && running) emitRows(values, n, w);
-      if (counts.state === BoardState.Ended && playback && !finished) {
-        finished = true;
-        ctx.finish();
-      }
-      if (throttle.due(ctx.now()) || n === 0) refresh();
-    };
-
-    const emitRows = (values: Float64Array, n: number, w: number): void => {
-      const c = link!.channels;
-      const f = out.frame(n);
-      clock.stamp(ctx.now(), f.t, n);
-      for (let i = 0; i < n; i++) {
-        const row = (i + 1) * w;
-        f.v.set(values.subarray(row, row + c), i * f.stride);
-      }
-      out.emit(f);
-      emitted += n;
-    };
-
-    const onError = (e: PythonCallError): void => {
-      inFlight = false;
-      awaiting();
-      if (e.kind === "crash" || e.kind === "timeout") return; // the restart reports it
-      // The module's failures are RuntimeErrors raised by poll: their message is the sentence.
-      lastFailure = e.message
-        .replace(/^RuntimeError: /, "")
-        .replace(/ \(at [^()]*, in poll\)$/, "");
-      // The module raises its own sentences: the traceback says nothing more (others keep it).
-      ctx.error(`BrainFlow: ${lastFailure}`, e.message === lastFailure ? e.traceback : undefined);
-      refresh();
-    };
-
-    const onStatus = (s: string, message?: string): void => {
-      if (!link) return;
-      if (s === "restarting") {
-        if (!sidecarDown) {
-          restarts++;
-          ctx.error(`BrainFlow: ${message ?? "the Python sidecar stopped"}; restarting it`);
-        }
-        sidecarDown = message ?? "the Python sidecar stopped; restarting";
-        inFlight = false;
-        clock.restart();
-        awaiting();
-      } else if (s === "ready") {
-        sidecarDown = "";
-      }
-      refresh();
-    };
-
-    const onOutput = (line: string): void => {
-      const now = ctx.now();
-      if (now - lastWarn < WARN_EVERY_S) return;
-      lastWarn = now;
-      ctx.warn(`BrainFlow: ${line}`);
-    };
-
-    link = await loadBoard(ctx, moduleParams(ctx, p), p.Channels.length, {
-      result: onResult,
-      error: onError,
-      status: onStatus,
-      output: onOutput,
+    if (!ctx.io.python) return withoutPython(ctx);
+    const run = new BrainFlowRun(ctx, {
+      target: targetOf(p),
+      playback: isPlayback(p.Board) && !p.Simulated,
+      pollRate: p.PollRate,
+      kinds: p.Channels,
     });
-    const sc = link.sidecar;
-    out = ctx.output(vectorShape(link.channels), "data");
-    if (ctx.declaredRate === undefined) ctx.setDesiredRate(link.rate);
-    clock = new DeviceClock(link.rate, 0.5, 1 / p.PollRate);
-    const names = channelNames(p.Channels, link.kindCounts);
-
-    const poll = (): void => {
-      if (inFlight || !running || !sc.ready) return;
-      if (sc.call(new Float64Array([CMD_POLL])) >= 0) {
-        inFlight = true;
-        awaiting();
-      }
-    };
-    const timer = ctx.every(p.PollRate, poll, { catchUp: "skip" });
-    refresh();
-
-    return {
-      start() {
-        running = true;
-        clock.restart();
-        timer.start();
-        if (ctx.virtual) ctx.warn(VIRTUAL_WARNING);
-        refresh();
-      },
-      stop() {
-        running = false;
-        timer.stop();
-        if (sc.ready) sc.call(new Float64Array([CMD_STOP]));
-        inFlight = false;
-        awaiting();
-      },
-      reset() {
-        emitted = 0;
-        clock.reset();
-        throttle.reset();
-        refresh();
-      },
-      dispose() {
-        running = false;
-        sc.close();
-      },
-      actions: {
-        channels: {
-          label: "Channels",
-          description: "The kind of each output channel",
-          run: () => names.join(", "),
-        },
-        counts: {
-          label: "Counts",
-          description: "Samples, lost samples, reconnections, failed attempts, sidecar restarts",
-          run: () =>
-            `${emitted} samples emitted (${counts.total} read by this sidecar), ${counts.lost} lost, ` +
-            `${counts.reconnects} reconnections, ${counts.failures} failed attempts, ${restarts} sidecar restarts` +
-            (lastFailure ? `; last failure: ${lastFailure}` : ""),
-        },
-      },
-    };
+    await run.load(moduleParams(ctx, p));
+    return run.instance();
   },
 });
-
-const AXES = ["x", "y", "z"];
-const AXIS_KINDS = new Set(["accel", "gyro", "magnetometer"]);
-
-/** "exg 1", "exg 2", …, "accel x" … per output channel. */
-export function channelNames(kinds: readonly string[], counts: readonly number[]): string[] {
-  const names: string[] = [];
-  kinds.forEach((kind, k) => {
-    const n = counts[k] ?? 0;
-    const axes = n === 3 && AXIS_KINDS.has(kind) ? AXES : undefined;
-    for (let i = 0; i < n; i++) names.push(`${kind} ${axes ? axes[i]! : i + 1}`);
-  });
-  return names;
-}
