@@ -69,7 +69,6 @@ export function paramOfError(message: string): string {
   if (/master board/.test(message)) return "MasterBoard";
   if (/channel kind|has no \w+ channels/.test(message)) return "Channels";
   if (/playback file/.test(message)) return "File";
-  if (/BrainFlowInputParams field/.test(message)) return "Board";
   return "Board";
 }
 

@@ -23,12 +23,14 @@ with a message that says what to check; later attempts failing the same way are 
 
 Params (JSON from the block): board (name or number), library (brainflow | mindrove | auto),
 input (BrainFlowInputParams fields), master_board (for the playback and streaming boards),
-channels (kinds: exg, emg, eeg, ecg, eog, accel, gyro, magnetometer, package,
-timestamp), poll_rate (Hz: the
-result holds up to 4 polls' samples, at least 32; or max_rows), silence (s;
+channels (kinds: exg, emg, eeg, ecg, eog, accel, gyro, magnetometer, package, timestamp),
+poll_rate (Hz: the result holds up to 4 polls' samples, at least 32; or max_rows), silence (s;
 0: never), buffer (BrainFlow's ring buffer, samples), simulated (BrainFlow's synthetic board in
-the board's layout and rate: Resampler), log_level (BrainFlow's logger: 0 trace … 6
-off), retry (a fixed wait between attempts, s, instead of the backoff; tests).
+the board's layout and rate: Resampler), log_level (BrainFlow's logger: 0 trace … 6 off), retry
+(a fixed wait between attempts, s, instead of the backoff; tests).
+
+A state of "waiting" (the session started, no data yet) becomes "streaming" with the first data;
+data after a failure counts as a reconnection.
 """
 
 from __future__ import annotations
