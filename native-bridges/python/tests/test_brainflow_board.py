@@ -1,9 +1,13 @@
 """mosaic_blocks.brainflow_board (the BrainFlow block's module), called as the sidecar calls it,
-on BrainFlow's own synthetic and playback boards (real BrainFlow sessions; no device needed)."""
+on BrainFlow's own synthetic and playback boards (real BrainFlow sessions; no device needed), a
+serial port that does not exist and a silent Cyton on a socat pty pair."""
 
 from __future__ import annotations
 
 import collections
+import os
+import shutil
+import subprocess
 import time
 
 import numpy as np
@@ -190,3 +194,34 @@ def test_simulated_mindrove_has_its_shape_and_rate():
     ts = data[:, 9]
     assert 0.8 * 500 < (len(data) - 1) / (ts[-1] - ts[0]) < 500 * 1.01
     assert header[B.H_LOST] == 0
+
+
+@pytest.mark.skipif(shutil.which("socat") is None, reason="needs socat for a pty pair")
+def test_a_silent_board_on_a_real_pty_is_a_clear_error(tmp_path):
+    # A Cyton on one end of a socat pty pair whose other end never answers.
+    port = str(tmp_path / "cyton")
+    socat = subprocess.Popen(
+        ["socat", f"pty,raw,echo=0,link={port}", f"pty,raw,echo=0,link={tmp_path / 'peer'}"],
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        t0 = time.monotonic()
+        while not os.path.exists(port) and time.monotonic() - t0 < 5:
+            time.sleep(0.02)
+        state = B.init({"board": "cyton", "input": {"serial_port": port}, "retry": 60})
+        raised = None
+        try:
+            while raised is None and time.monotonic() - t0 < 30:
+                try:
+                    B.poll(POLL, state)
+                except RuntimeError as e:
+                    raised = str(e)
+                time.sleep(0.05)
+        finally:
+            state.stopping.set()  # its retry wait ends at once; the thread is a daemon
+    finally:
+        socat.terminate()
+        socat.wait()
+    assert raised is not None
+    assert f"brainflow board cyton on {port}: BOARD_NOT_READY_ERROR" in raised
+    assert "the board does not answer" in raised
