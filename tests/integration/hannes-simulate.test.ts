@@ -83,23 +83,42 @@ function readLog(file: string): number[][] {
 }
 
 /** `mosaic run FILE --json` as a child; resolves with its exit code and output. */
-function runAsync(
-  args: string[],
-  untilMs = 60_000,
-): { child: ChildProcess; out: () => string; done: Promise<number | null> } {
+interface Run {
+  child: ChildProcess;
+  out: () => string;
+  done: Promise<number | null>;
+  exited: () => boolean;
+}
+
+function runAsync(args: string[], untilMs = 60_000): Run {
   const child = startCli(args);
   children.push(child);
   let out = "";
+  let exited = false;
   child.stdout!.on("data", (d: Buffer) => (out += d.toString()));
   child.stderr!.on("data", (d: Buffer) => (out += d.toString()));
   const done = new Promise<number | null>((res) => {
     const t = setTimeout(() => child.kill("SIGKILL"), untilMs);
     child.on("exit", (c) => {
+      exited = true;
       clearTimeout(t);
       res(c);
     });
   });
-  return { child, out: () => out, done };
+  return { child, out: () => out, done, exited: () => exited };
+}
+
+/** Waits until the block `name` says it listens; fails at once, with its output, if the run ended. */
+async function listening(run: Run, name: string): Promise<void> {
+  const ready = (): boolean =>
+    statusTexts(run.out(), name).some((t) => t.startsWith("listening on"));
+  await waitFor(
+    () => ready() || run.exited(),
+    40_000,
+    () => `${name} listening: ${run.out().slice(-1500)}`,
+  );
+  if (!ready())
+    throw new Error(`mosaic run ended before ${name} listened: ${run.out().slice(-1500)}`);
 }
 
 /** A child `mosaic simulate …`: its stdout lines. */
@@ -117,8 +136,9 @@ interface Telemetry {
   blocks: { name: string; text: string }[];
 }
 
+/** The block's status texts in `run --json`'s telemetry so far (whole lines only). */
 function statusTexts(out: string, name: string): string[] {
-  return jsonLines(out)
+  return jsonLines(out.slice(0, out.lastIndexOf("\n") + 1))
     .filter((m) => m.type === "telemetry")
     .map((m) => (m as unknown as Telemetry).blocks.find((b) => b.name === name)?.text ?? "");
 }
@@ -337,11 +357,7 @@ gui: { Type: HannesGUI, Inputs: [ control, raw, arv ], Params: [ 127.0.0.1, ${gu
       `emg: { Type: HannesReceiver, Params: { Host: 127.0.0.1, Port: ${port}, Channels: 6 }, Path: logs }\n`,
     );
     const run = runAsync(["run", file, "--duration", "60", "--json"]);
-    await waitFor(
-      () => statusTexts(run.out(), "emg").some((t) => t.startsWith("listening on")),
-      40_000,
-      () => `the receiver listening (${run.out().slice(-1500)})`,
-    );
+    await listening(run, "emg");
     const sim = new HannesEmgSimulator({ host: "127.0.0.1", port, rate: 100, count: 200 });
     closers.push(() => sim.close());
     await sim.waitFor(() => sim.done, "end of the stream", 20_000);
@@ -357,6 +373,76 @@ gui: { Type: HannesGUI, Inputs: [ control, raw, arv ], Params: [ 127.0.0.1, ${gu
       ),
     );
     expect(sim.failed).toBe(0);
+  }, 90_000);
+
+  test("the EMG simulator stopped and started again: repeats counted, the new stream read exactly", async () => {
+    requireBuild();
+    const dir = tempDir("mosaic-hannes-sim-");
+    const port = await freePort();
+    const file = join(dir, "paced.yaml");
+    writeFileSync(
+      file,
+      `timer: { Type: ScheduledTimer, DesiredRate: 100 }
+emg: { Type: HannesReceiver, Inputs: [ timer ], Params: { Host: 127.0.0.1, Port: ${port}, Channels: 6 }, Path: logs }
+`,
+    );
+    const run = runAsync(["run", file, "--duration", "60", "--json"]);
+    const last = (): string => statusTexts(run.out(), "emg").at(-1) ?? "";
+    await listening(run, "emg");
+    const stream = async (first: number): Promise<void> => {
+      const sim = new HannesEmgSimulator({ host: "127.0.0.1", port, count: 150, first });
+      closers.push(() => sim.close());
+      await sim.waitFor(() => sim.done, "end of the stream", 20_000);
+      await sim.close();
+    };
+    await stream(0);
+    await waitFor(
+      () => /150 datagrams/.test(last()),
+      5000,
+      () => `150 datagrams (${last()})`,
+    );
+    await sleep(1000); // silence: every tick repeats the last sample
+    await stream(5000);
+    await waitFor(
+      () => /300 datagrams/.test(last()),
+      5000,
+      () => `300 datagrams (${last()})`,
+    );
+    await sleep(300);
+    run.child.kill("SIGINT");
+    expect(await run.done).toBe(0);
+    const status = last().startsWith("stopped") ? statusTexts(run.out(), "emg").at(-2)! : last();
+    const repeated = Number(/(\d+) ticks without a new sample/.exec(status)?.[1] ?? 0);
+    const dropped = Number(/(\d+) dropped/.exec(status)?.[1] ?? 0);
+    expect(repeated, status).toBeGreaterThanOrEqual(80); // the 1 s of silence, at least
+
+    // Every row logged is a datagram sent (or zeros before the first), in order; a datagram is
+    // missing only where the block says it dropped one (more than MaxDelay waiting).
+    const byRow = new Map<string, number>();
+    for (const first of [0, 5000]) {
+      for (let i = first; i < first + 150; i++) {
+        byRow.set(Array.from({ length: 6 }, (_, k) => hannesEmgValue(i, k)).join(), i);
+      }
+    }
+    const rows = readLog(join(dir, "logs", "emg.txt")).map((r) => r.slice(1));
+    const unknown = rows.filter((r) => r.some((x) => x !== 0) && !byRow.has(r.join()));
+    expect(unknown).toEqual([]);
+    const seq: number[] = [];
+    for (const r of rows) {
+      const i = byRow.get(r.join());
+      if (i !== undefined && i !== seq.at(-1)) seq.push(i);
+    }
+    let gaps = 0;
+    for (let j = 1; j < seq.length; j++) {
+      expect(seq[j]).toBeGreaterThan(seq[j - 1]!);
+      if (seq[j - 1]! < 5000 && seq[j]! >= 5000) continue; // the restart
+      gaps += seq[j]! - seq[j - 1]! - 1;
+    }
+    expect(seq[0]).toBe(0);
+    expect(seq.at(-1)).toBe(5149);
+    expect(seq.filter((i) => i < 5000).at(-1)).toBe(149);
+    expect(seq.find((i) => i >= 5000)).toBe(5000);
+    expect(gaps).toBeLessThanOrEqual(dropped);
   }, 90_000);
 });
 
@@ -446,11 +532,7 @@ describe.skipIf(!haveSocat)("mosaic simulate hannes, hannes-gui, hannes-emg", ()
         .replace("Channels: 6 } }", "Channels: 6 }, Path: logs }"),
     );
     const run = runAsync(["run", file, "--duration", "60", "--json"]);
-    await waitFor(
-      () => statusTexts(run.out(), "Hannes").some((t) => t.startsWith("listening on")),
-      20_000,
-      "the receiver listening",
-    );
+    await listening(run, "Hannes");
     const emg = simulate(["hannes-emg", "--to", `127.0.0.1:${emgPort}`, "--count", "150"]);
     await waitFor(
       () => emg.lines.some((l) => l.endsWith("150 datagrams sent · done")),
