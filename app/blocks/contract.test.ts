@@ -499,6 +499,16 @@ const SETUPS: Record<string, Setup | Setup[]> = {
     { params: { Probes: [1] }, inputs: [timer(2000)] },
   ],
   Delsys: { params: { Sensors: 4 }, inputs: [timer(1926)] },
+  // Without a TCP bridge it says so and sends nothing (tests/integration/sessantaquattro.test.ts
+  // streams it).
+  Sessantaquattro: [
+    { params: {}, inputs: [], silent: true },
+    {
+      params: { Model: "Sessantaquattro+", Channels: 8, HighRes: true, Extras: false },
+      inputs: [],
+      silent: true,
+    },
+  ],
   // Without a TCP bridge it says so and sends nothing (tests/integration/quattrocento.test.ts streams it).
   Quattrocento: [
     { params: {}, inputs: [], silent: true },
@@ -510,6 +520,9 @@ const SETUPS: Record<string, Setup | Setup[]> = {
   ],
   DLR_ADCBT: { params: { Port: "COM5", Channels: 3 }, inputs: [timer(100)] },
   NilsPod: { params: {}, inputs: [timer(100)] },
+  // Without the Python sidecar it says Python is needed and sends nothing
+  // (tests/integration/brainflow.test.ts streams the synthetic and playback boards).
+  BrainFlow: { params: { Board: "SYNTHETIC_BOARD" }, inputs: [], silent: true },
   ImuSimulator: [
     { params: {}, inputs: [timer(100)] },
     { params: { Layout: "myo", NoiseStd: 0 }, inputs: [timer(50)] },
@@ -527,6 +540,12 @@ const SETUPS: Record<string, Setup | Setup[]> = {
       silent: true,
     },
   ],
+  // Without the LSL bridge here (the browser build's case): they say so and send nothing
+  // (tests/integration/lsl.test.ts runs them against liblsl and pylsl).
+  LslOutlet: { params: { Name: "EMG", Format: "int16" }, inputs: [vec(4)], silent: true },
+  LslMarkers: { params: { Labels: ["rest", "power"] }, inputs: [vec(1)], silent: true },
+  LslInlet: { params: { Name: "EMG", Channels: 8 }, inputs: [] },
+  LslMarkerInlet: { params: { Type: "Markers" }, inputs: [] },
   // A source fed by its socket: nothing to feed here (tests/integration/udp.test.ts runs it).
   UdpReceiver: { params: { Port: 9, Channels: 3 }, inputs: [] },
   SerialPort: [
