@@ -214,8 +214,15 @@ export interface BlockContext {
    * tick and the skipped ones are counted as missed.
    */
   every(hz: number, tick: TickCallback, options?: { catchUp?: CatchUp }): TimerHandle;
-  /** A one-shot callback at clock time `t`; a later call replaces a pending one. */
-  at(t: number, fn: (t: number) => void): void;
+  /**
+   * A one-shot callback at clock time `t`; a later call replaces a pending one. With `latest`
+   * (> t), it may run anywhere from `t` to `latest`: when the worker wakes for something else in
+   * between (as batched timer ticks do), else at `latest` — for a source whose events go out
+   * together within a batching interval, so that they are delivered in the same steps as the
+   * timers' ticks of the same times. The callback gets its due time `t`; `ctx.now()` is when it
+   * really runs.
+   */
+  at(t: number, fn: (t: number) => void, latest?: number): void;
   /** One line of live status text ("waiting for device", "row 120/2000"). */
   setText(text: string): void;
   /** A warning shown in the block's status (and printed by the CLI), rate-limited. */

@@ -23,6 +23,8 @@ import {
   TIME_COLUMN_NAMES,
   type ParseOptions,
 } from "./delimited-text";
+import { recordingKind, recordingRows } from "./recording-rows";
+import type { RowSource } from "./row-source";
 
 const columnRef = () => z.union([z.string().min(1), index()]);
 /** Most rows one wake-up of a self-timed player waits for (a batching interval rarely holds more). */
@@ -34,7 +36,11 @@ export const FilePlayer = defineBlock({
   summary: "Plays a CSV/text recording: one row per timer tick, or at the recording's own timing.",
   help:
     "Reads and plays back a recording (paper Table 3), e.g. a CSV with a `time_s` column or a " +
-    "log written by `Path`/Logger (then set `TimeColumn: 0`). A file up to 32 MiB is read and " +
+    "log written by `Path`/Logger (then set `TimeColumn: 0`), or a lab recording: an XDF file " +
+    "(one stream, `Stream`; its timestamps exactly as written, so a recording made by an " +
+    "XdfRecorder replays with the stamps it was recorded with) or an EDF+/BDF+ file (signals of " +
+    "one rate; times from each record's time-keeping annotation), read whole (up to 512 MiB; " +
+    "Node hosts only), their channel names becoming the output's labels. A file up to 32 MiB is read and " +
     "checked whole when the pipeline loads; a bigger one is read in pieces as it plays (memory " +
     "stays small whatever its size), after its layout, first 1000 rows and last line were " +
     "checked at load, and a line that cannot be read later stops it with an error naming the " +
@@ -56,7 +62,8 @@ export const FilePlayer = defineBlock({
       .string()
       .min(1)
       .describe(
-        "The recording to play, relative to the pipeline file (CSV or other delimited text)",
+        "The recording to play, relative to the pipeline file: CSV or other delimited text, " +
+          "an XDF file (.xdf) or an EDF+/BDF+ file (.edf, .bdf)",
       ),
     Columns: z
       .array(columnRef())
@@ -65,7 +72,8 @@ export const FilePlayer = defineBlock({
       .optional()
       .describe(
         "Columns to play, in output order: header names or 0-based indices (default: every " +
-          "column except the time column)",
+          "column except the time column); for XDF the stream's channels, for EDF+/BDF+ the " +
+          "signals (labels or indices), all of one rate",
       ),
     TimeColumn: z
       .union([columnRef(), z.literal(false)])
@@ -86,6 +94,13 @@ export const FilePlayer = defineBlock({
       .describe(
         "Field separator; auto picks tab, comma, semicolon or spaces from the first line " +
           "(' ' means any run of spaces or tabs)",
+      ),
+    Stream: z
+      .union([z.string().min(1), index()])
+      .optional()
+      .describe(
+        "XDF recordings: the stream to play, by name or 0-based index (default: the first " +
+          "numeric stream)",
       ),
     Loop: z.boolean().default(false).describe("Start again from the first row at the end"),
     Speed: z
@@ -127,40 +142,12 @@ export const FilePlayer = defineBlock({
 interface Params {
   File: string;
   Columns?: (string | number)[] | undefined;
+  Stream?: string | number | undefined;
   TimeColumn?: string | number | false | undefined;
   Header: "auto" | boolean;
   Delimiter: "auto" | "," | ";" | "\t" | " ";
   Loop: boolean;
   Speed: number;
-}
-
-/**
- * The rows of a recording as the player reads them: all in memory (a file up to
- * FILE_LIMITS.wholeBytes, checked whole at load), or streamed from the file as they play. Row
- * indices count from the first data row of the current pass.
- */
-interface RowSource {
-  /** Every row is in memory: a scan may look past the end into the next pass (Loop). */
-  readonly whole: boolean;
-  /** Values per row. */
-  readonly width: number;
-  readonly hasTimes: boolean;
-  /** Rows in a pass, once known (from the start for a whole file). */
-  readonly total: number | undefined;
-  /** Makes rows [0, upTo) readable where they exist; returns min(upTo, rows available). */
-  fill(upTo: number): number;
-  time(r: number): number;
-  line(r: number): number;
-  copy(r: number, into: Float64Array, at: number): void;
-  /** Rows before `r` are not needed any more. */
-  release(r: number): void;
-  /** The next pass, from the first row. */
-  rewind(): void;
-  /** The time of the file's last row. */
-  lastTime(): number;
-  /** Why the rows end before the file does (a bad line met while playing). */
-  readonly error: string | undefined;
-  close(): void;
 }
 
 const disorderText = (line: number, file: string, t: number, prev: number): string =>
@@ -173,6 +160,7 @@ function wholeRows(text: string, o: ParseOptions): RowSource {
   return {
     whole: true,
     width: c,
+    ...(t.hasHeader ? { labels: t.columns.map((k) => t.names[k]!) } : {}),
     hasTimes: t.times !== null,
     total: t.rows,
     fill: (upTo) => Math.min(upTo, t.rows),
@@ -288,6 +276,8 @@ async function loadRows(res: Resources, p: Params, ordered: boolean): Promise<Ro
       "File",
     );
   }
+  const kind = recordingKind(p.File);
+  if (kind) return openRecording(h, kind, p);
   if (h && h.size > FILE_LIMITS.wholeBytes) {
     try {
       return streamedRows(h, o, ordered);
@@ -313,6 +303,25 @@ async function loadRows(res: Resources, p: Params, ordered: boolean): Promise<Ro
     );
   }
   return wholeRows(text, o);
+}
+
+/** An XDF or EDF+/BDF+ recording, read whole (Node hosts; a browser cannot read them yet). */
+function openRecording(h: FileReadHandle | undefined, kind: "xdf" | "edf", p: Params): RowSource {
+  if (!h) {
+    throw new BlockConfigError(
+      `'${p.File}' is ${kind === "xdf" ? "an XDF" : "an EDF+/BDF+"} recording: this runtime cannot read binary files (play it with mosaic run, mosaic serve or the desktop app)`,
+      "File",
+    );
+  }
+  try {
+    return recordingRows(h, kind, {
+      file: p.File,
+      stream: p.Stream,
+      columns: p.Columns,
+    });
+  } finally {
+    h.close();
+  }
 }
 
 /** The load-time checks of original timing and the player itself. */
@@ -383,7 +392,10 @@ function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): Blo
   }
   const speed = p.Speed;
   const loop = p.Loop;
-  const out = ctx.output(vectorShape(c));
+  const out = ctx.output(vectorShape(c), undefined, {
+    ...(src.labels ? { labels: src.labels } : {}),
+    ...(src.unit ? { unit: src.unit } : {}),
+  });
 
   let row = 0;
   let loops = 0;
@@ -438,8 +450,11 @@ function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): Blo
     return [0, l + 1];
   };
   /**
-   * When to wake next: the due time of the last row within the batching interval of the next
-   * one (rows then go out together, as a device sends packets; DESIGN.md §3).
+   * When the worker must wake at the latest: the due time of the last row within the batching
+   * interval of the next one (rows then go out together, as a device sends packets; DESIGN.md
+   * §3). From the next row's due time on, the rows due go out whenever the worker is awake
+   * anyway, in the same steps as timer ticks of the same times (so a replay meets the other
+   * inputs of a block as the recorded run did).
    */
   const nextWake = (): number => {
     const first = dueTime(row, loops);
@@ -457,8 +472,11 @@ function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): Blo
     return last;
   };
 
-  const onTime = (t: number): void => {
+  const arm = (): void => ctx.at(dueTime(row, loops), onTime, nextWake());
+
+  const onTime = (): void => {
     if (paused || done) return;
+    const t = ctx.now();
     for (;;) {
       // Count the rows due by now, then emit them in one frame stamped with their own times.
       let n = 0;
@@ -492,12 +510,12 @@ function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): Blo
       break;
     }
     if (throttle.due(t)) describe();
-    ctx.at(nextWake(), onTime);
+    arm();
   };
 
   const schedule = () => {
     if (timed || paused || done || !started) return;
-    ctx.at(nextWake(), onTime);
+    arm();
   };
   const rewind = () => {
     if (row !== 0 || loops !== 0 || done) src.rewind();

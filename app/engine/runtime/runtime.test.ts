@@ -344,6 +344,28 @@ describe("scheduler", () => {
     expect(s.nextWake()).toBe(10);
   });
 
+  test("a one-shot with a latest time runs when the worker is awake from its due time on, else wakes it then", () => {
+    const s = new Scheduler(true);
+    const ran: number[] = [];
+    const shot = s.addOneShot("player", (t) => ran.push(t));
+    s.once(shot, 10.001, 10.004);
+    const tick = s.addPeriodic("t", 500, () => {});
+    s.start(tick, 10);
+    fireAll(s, 10);
+    expect(ran).toEqual([]);
+    // Nothing else due before 10.004: the worker wakes for the one-shot at its latest time.
+    s.stop(tick);
+    expect(s.nextWake()).toBe(10.004);
+    // Awake at 10.002 for something else: it runs then (stamped with its due time).
+    s.start(tick, 10.002);
+    fireAll(s, 10.002);
+    expect(ran).toEqual([10.001]);
+    // Without a latest time a one-shot wakes the worker at its due time, as before.
+    s.once(shot, 11);
+    s.stop(tick);
+    expect(s.nextWake()).toBe(11);
+  });
+
   test("a very long stall is delivered in bounded calls, nothing lost", () => {
     const s = new Scheduler(false);
     let total = 0;

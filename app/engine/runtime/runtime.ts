@@ -727,12 +727,12 @@ export class Runtime {
           },
         };
       },
-      at(t: number, fn: (t: number) => void) {
+      at(t: number, fn: (t: number) => void, latest?: number) {
         if (!node.oneShot) {
           node.oneShot = sched.addOneShot(node.name, fn);
         }
         node.oneShot.cb = fn;
-        sched.once(node.oneShot, t);
+        sched.once(node.oneShot, t, latest);
         rt.onWake?.();
       },
       setText(text: string) {

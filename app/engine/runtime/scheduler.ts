@@ -94,6 +94,11 @@ export interface TimerEntry {
   onTicks: TickCallback;
   /** One-shot entries. */
   cb: (t: number) => void;
+  /**
+   * One-shots: when the worker must wake for it at the latest (≥ next). Between `next` and this,
+   * it runs when the worker is awake anyway, as a batched timer's ticks do.
+   */
+  wakeAt: number;
 }
 
 /** Largest batch of one call (after a very long stall the rest follows in further calls). */
@@ -156,6 +161,7 @@ export class Scheduler {
       times: new Float64Array(period > 0 ? 8 : 1),
       onTicks,
       cb,
+      wakeAt: Infinity,
     };
     this.entries.push(e);
     return e;
@@ -174,9 +180,10 @@ export class Scheduler {
   }
 
   /** Schedules a one-shot entry at absolute time t. */
-  once(e: TimerEntry, t: number): void {
+  once(e: TimerEntry, t: number, latest = t): void {
     e.period = 0;
     e.next = t;
+    e.wakeAt = Math.max(t, latest);
     e.running = true;
   }
 
@@ -270,7 +277,8 @@ function dueCount(e: TimerEntry, limit: number): number {
 
 /** The time at which `e` wants the worker awake (see the module comment on batching). */
 export function wakeTime(e: TimerEntry): number {
-  if (e.period <= 0 || e.catchUp === "skip" || e.batchS <= 0) return e.next;
+  if (e.period <= 0) return e.running ? e.wakeAt : e.next;
+  if (e.catchUp === "skip" || e.batchS <= 0) return e.next;
   const extra = Math.floor(e.batchS * e.rate + 1e-9);
   return extra > 0 ? e.base + (e.k + extra) / e.rate : e.next;
 }
