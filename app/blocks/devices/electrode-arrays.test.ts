@@ -2,6 +2,8 @@ import { describe, expect, test } from "vitest";
 import { BlockHarness } from "../../engine/testing";
 import { ELECTRODE_ARRAYS, electrodeGrid, type ElectrodeArrayCode } from "./electrode-arrays";
 import { Quattrocento } from "./quattrocento";
+import { MuoviSingleProbe } from "./muovi-single-probe";
+import { EMPTY_SHAPE } from "../../engine";
 
 const grid = (Array: ElectrodeArrayCode, Orientation: 0 | 180, FirstChannel = 0, outputs = 64) =>
   electrodeGrid({ Array, Orientation, FirstChannel }, outputs)!;
@@ -67,5 +69,26 @@ describe("a block that reads an array declares it", () => {
         { io: {} },
       ),
     ).rejects.toThrow(/Grid: GR10MM0808 has 64 channels; from channel 0 the output has only 16/);
+  });
+});
+
+describe("Muovi blocks declare their probes' channels and arrays", () => {
+  test("MuoviSingleProbe (native): labels per probe channel, the array from a channel; paced: Grid refused", async () => {
+    const h = await BlockHarness.create(
+      MuoviSingleProbe,
+      { Probes: [2], Grid: { Array: "HD10MM0804", Orientation: 0 } },
+      { io: {} },
+    );
+    const meta = h.metas.get("emg")!;
+    expect(meta.labels!.slice(0, 2)).toEqual(["probe 3 ch 1", "probe 3 ch 2"]);
+    expect(meta.unit).toBe("mV");
+    expect(meta.grid!.rows * meta.grid!.cols).toBe(32);
+    await expect(
+      BlockHarness.create(
+        MuoviSingleProbe,
+        { Probes: [0], Grid: { Array: "HD10MM0804" } },
+        { io: {}, inputs: [{ shape: EMPTY_SHAPE, rate: 100, isTimer: true }] },
+      ),
+    ).rejects.toThrow(/Grid places a vector's channels on an electrode array/);
   });
 });

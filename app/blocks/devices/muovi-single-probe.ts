@@ -10,6 +10,8 @@ import { pacedDevice, pacingTimer } from "./paced-device";
 import { MUOVI_CHANNELS, MUOVI_PROBE_PORT, MUOVI_RATE } from "./muovi-protocol";
 import { muoviProbeProtocol, MuoviProbeLink } from "./muovi-link";
 import { linkCountsText, nativeStreamSource } from "./stream-link";
+import { gridParam } from "./electrode-arrays";
+import { muoviMeta } from "./muovi-meta";
 import { MUOVI_MV_PER_BIT } from "./muovi-protocol";
 
 const params = z.strictObject({
@@ -23,6 +25,7 @@ const params = z.strictObject({
       "0-based probe indices, as MOSAIC read them (one probe streams here; each index adds 32 " +
         "channels to the output)",
     ),
+  Grid: gridParam(),
   Port: z
     .number()
     .int()
@@ -100,6 +103,7 @@ export const MuoviSingleProbe = defineBlock({
       const cols = MUOVI_CHANNELS * p.Probes.length;
       const instance = nativeStreamSource(ctx, {
         rate: MUOVI_RATE,
+        meta: muoviMeta(p.Probes, p.Grid, "mV"),
         maxLead: 0.02,
         channels: cols,
         target: `a Muovi probe on TCP port ${p.Port}`,
@@ -115,6 +119,13 @@ export const MuoviSingleProbe = defineBlock({
         },
       });
       return { ...instance, actions };
+    }
+    if (p.Grid !== undefined) {
+      throw new BlockConfigError(
+        "Grid places a vector's channels on an electrode array: it applies without a timer input " +
+          "(one vector per sample); the timer-paced form emits matrices of samples",
+        "Grid",
+      );
     }
     const rate = pacingTimer(ctx);
     const rows = muoviRows(rate);

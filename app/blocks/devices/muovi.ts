@@ -16,6 +16,8 @@ import {
 } from "./muovi-protocol";
 import { muoviProtocol, SyncStationLink } from "./muovi-link";
 import { linkCountsText, nativeStreamSource } from "./stream-link";
+import { gridParam } from "./electrode-arrays";
+import { muoviMeta } from "./muovi-meta";
 import { MUOVI_FULL_SCALE, slotOffsets } from "./muovi-protocol";
 
 const params = z.strictObject({
@@ -28,6 +30,7 @@ const params = z.strictObject({
       "0-based indices of the probes on the SyncStation (the number on the probe minus 1), in " +
         "the order their channels appear in the output",
     ),
+  Grid: gridParam(),
   Host: z
     .string()
     .trim()
@@ -110,6 +113,7 @@ export const Muovi = defineBlock({
       const o = { host: p.Host, port: p.Port, slots: p.Probes };
       const instance = nativeStreamSource(ctx, {
         rate: MUOVI_RATE,
+        meta: muoviMeta(p.Probes, p.Grid),
         maxLead: 0.02,
         channels: MUOVI_CHANNELS * offsets.length,
         target: `the SyncStation at ${p.Host}:${p.Port}`,
@@ -136,6 +140,7 @@ export const Muovi = defineBlock({
       device: "Muovi",
       target: `the Muovi SyncStation at ${p.Host}:${p.Port} (TCP)`,
       shape: vectorShape(MUOVI_CHANNELS * p.Probes.length),
+      meta: muoviMeta(p.Probes, p.Grid),
       port: "emg",
       // Two of the SyncStation's packets (40 samples each, as public readers take them) wait at most.
       maxQueue: 2 * Math.ceil(40 / averageOver) + 1,

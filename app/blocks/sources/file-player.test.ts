@@ -136,6 +136,29 @@ describe("FilePlayer", () => {
     expect(h.output().v.flat()).toEqual([1, 2, 1]);
   });
 
+  test("seek: plays on from the row at that time, at once; bad or out-of-range times are refused", async () => {
+    const csv = "t,x\n0,1\n1,2\n2,3\n3,4\n4,5\n";
+    const h = await player({ File: "r.csv" }, { "r.csv": csv }, { now: 0 });
+    h.start();
+    h.fireOneShot(); // row 0 at 0
+    h.clock = 0.5;
+    const seek = h.instance.actions!.seek!;
+    expect(seek.run(2.5)).toBe("at 3 s (row 4)");
+    h.fireOneShot();
+    h.fireOneShot();
+    expect(h.output().t).toEqual([0, 0.5, 1.5]);
+    expect(h.output().v.flat()).toEqual([1, 4, 5]);
+    expect(h.finished).toBe(true);
+    // After the end, a seek plays again from there.
+    h.clock = 10;
+    expect(seek.run("1")).toBe("at 1 s (row 2)");
+    h.fireOneShot();
+    expect(h.output().v.flat()).toEqual([1, 4, 5, 2]);
+    expect(seek.run(9)).toBe("the recording lasts 4 s: nothing at 9 s");
+    expect(seek.run(-1)).toMatch(/^seek: give the seconds/);
+    expect(seek.run("soon")).toMatch(/^seek: give the seconds/);
+  });
+
   test("original timing: after stop and start the remaining rows move by the stopped time", async () => {
     const csv = "t,x\n0,1\n1,2\n2,3\n";
     const h = await player({ File: "r.csv" }, { "r.csv": csv }, { now: 0 });

@@ -125,7 +125,8 @@ export const FilePlayer = defineBlock({
   inputs: { min: 0, max: 1, labels: ["timer"] },
   finite: (p) => !p.Loop,
   views: ["scope"],
-  panel: "Scope of the played columns, the row position, and restart/pause/resume buttons.",
+  panel:
+    "Scope of the played columns, the row position, and restart/pause/resume buttons; seek to a time (seconds) with the Seek action.",
   async create(ctx, p) {
     const timed = ctx.inputs.length === 1;
     if (timed) timerInput(ctx, 0);
@@ -149,6 +150,9 @@ interface Params {
   Loop: boolean;
   Speed: number;
 }
+
+/** Seconds for messages: at most 3 decimals. */
+const fmtSeconds = (x: number): string => String(Math.round(x * 1000) / 1000);
 
 const disorderText = (line: number, file: string, t: number, prev: number): string =>
   `line ${line} of '${file}': time ${t} is before the previous row's ${prev}; original ` +
@@ -517,6 +521,43 @@ function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): Blo
     if (timed || paused || done || !started) return;
     arm();
   };
+  /** The first row at or after `s` seconds from the first row (rows are in time order). */
+  const rowAt = (s: number): number | undefined => {
+    const total = src.total ?? 0;
+    const want = src.time(0) + s;
+    let lo = 0;
+    let hi = total;
+    while (lo < hi) {
+      const mid = (lo + hi) >> 1;
+      if (src.time(mid) < want) lo = mid + 1;
+      else hi = mid;
+    }
+    return lo < total ? lo : undefined;
+  };
+
+  /** The `seek` action: play on from the row at `arg` seconds (whole files, timed by their rows). */
+  const seek = (arg: unknown): string => {
+    const s = typeof arg === "string" ? Number(arg) : arg;
+    if (typeof s !== "number" || !Number.isFinite(s) || s < 0) {
+      return "seek: give the seconds from the recording's first row, e.g. 12.5";
+    }
+    if (!src.whole || !src.hasTimes) {
+      return src.hasTimes
+        ? `seek needs a recording read whole (text up to ${FILE_LIMITS.wholeBytes} bytes, XDF or EDF+)`
+        : "seek needs a time column";
+    }
+    const r = rowAt(s);
+    if (r === undefined) {
+      return `the recording lasts ${fmtSeconds(src.lastTime() - src.time(0))} s: nothing at ${s} s`;
+    }
+    row = r;
+    done = false;
+    if (!timed && started) base = ctx.now() - (src.time(r) - t0 + loops * span) / speed;
+    describe();
+    schedule();
+    return `at ${fmtSeconds(src.time(r) - src.time(0))} s (row ${r + 1})`;
+  };
+
   const rewind = () => {
     if (row !== 0 || loops !== 0 || done) src.rewind();
     row = 0;
@@ -599,6 +640,11 @@ function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): Blo
           describe();
           return `paused at row ${row}`;
         },
+      },
+      seek: {
+        label: "Seek",
+        description: "Jump to a time: seconds from the recording's first row (argument)",
+        run: (arg?: unknown) => seek(arg),
       },
       resume: {
         label: "Resume",
