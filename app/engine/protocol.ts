@@ -72,6 +72,23 @@ export const uiMessageSchema = z.discriminatedUnion("type", [
     block: z.string().min(1),
     port: z.string().optional(),
   }),
+  /**
+   * Records block outputs into one file (a session recording, not a pipeline edit): in the data
+   * folder where the host writes files, else in memory and downloaded when it stops. `file`: a
+   * plain name (no folder); default from the date and time.
+   */
+  z.strictObject({
+    type: z.literal("record-start"),
+    id,
+    outputs: z
+      .array(z.strictObject({ block: z.string().min(1), port: z.string().min(1).optional() }))
+      .min(1)
+      .max(4096),
+    format: z.enum(["xdf", "edf", "bdf"]),
+    file: z.string().min(1).max(200).optional(),
+  }),
+  /** Finishes the session recording (a download in the browser build). */
+  z.strictObject({ type: z.literal("record-stop"), id }),
 ]);
 
 export type UiMessage = z.infer<typeof uiMessageSchema>;
@@ -192,6 +209,27 @@ export interface DataMessage {
   skipped: number;
 }
 
+export type RecordingFormatName = "xdf" | "edf" | "bdf";
+
+/** A session recording (`record-start`), sent while it runs (~4 Hz) and when it ends. */
+export interface RecordingStatus {
+  state: "recording" | "finished" | "failed";
+  /** The file's name (its full path where the host writes files). */
+  file: string;
+  format: RecordingFormatName;
+  /** The outputs recorded, as inputs are written ("Emg", "Myo.imu"). */
+  outputs: string[];
+  /** Seconds since it started. */
+  duration: number;
+  bytes: number;
+  /** Samples (events) written, all outputs. */
+  samples: number;
+  /** Kept in memory (browser build): downloaded when it stops. */
+  inMemory: boolean;
+  /** Why it failed (state "failed"). */
+  error?: string;
+}
+
 export type EngineMessage =
   | {
       type: "hello";
@@ -220,6 +258,12 @@ export type EngineMessage =
   | { type: "graph"; graph: GraphInfo }
   | { type: "telemetry"; telemetry: Telemetry }
   | { type: "event"; event: RuntimeEvent }
+  | { type: "recording"; recording: RecordingStatus }
+  /**
+   * A file for the page to save (browser build, where the engine cannot write files): a finished
+   * session recording, a Buffer's or a model's save. Sent only to the page that runs the engine.
+   */
+  | { type: "download"; name: string; mime: string; bytes: Uint8Array }
   | DataMessage;
 
 /** What the UI holds to talk to an engine, whatever the transport. */

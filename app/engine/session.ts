@@ -28,6 +28,8 @@ import type { LogSink } from "./runtime/logsink";
 import { Runtime } from "./runtime/runtime";
 import type { Resources } from "./block";
 import type { IoBridges } from "./io";
+import type { RecordingFormats } from "./recording/format";
+import { SessionRecorder } from "./recording/session-recorder";
 
 export interface LoopHandle {
   stop(): void;
@@ -57,6 +59,13 @@ export interface SessionPlatform {
   loadPipeline?(source: string, file: string): Promise<LoadResult>;
   /** Device and network bridges for blocks (the Node host's; none in the browser). */
   io?: IoBridges;
+  /** The file formats session recordings (`record-start`) can write; none: it refuses. */
+  recordingFormats?: RecordingFormats;
+  /**
+   * Where session recordings of the pipeline `file` go (their `recordings/` folder is created
+   * there); default `resources(file)`. Without `openWrite` they are kept in memory and downloaded.
+   */
+  recordings?(file: string): Resources;
   startLoop(rt: Runtime, hooks: LoopHooks): LoopHandle;
   post(msg: EngineMessage, transfer?: ArrayBuffer[]): void;
 }
@@ -224,6 +233,9 @@ export class EngineSession {
   private readonly watches = new Map<string, Watch>();
   /** The load in progress (loads go one after another). */
   private loading: Promise<unknown> = Promise.resolve();
+  /** The session recording (Record button), and when its status was last sent. */
+  private recorder: SessionRecorder | undefined;
+  private recordingSentAt = -Infinity;
 
   constructor(
     private readonly catalog: Catalog,
@@ -338,6 +350,14 @@ export class EngineSession {
         w.untap = rt.tap(msg.block, p.name, (f) => w.add(f));
         this.watches.set(key, w);
         this.reply(msg.id, true);
+        return;
+      }
+      case "record-start":
+        this.reply(msg.id, true, this.startRecording(msg));
+        return;
+      case "record-stop": {
+        const m = this.finishRecording();
+        this.reply(msg.id, m !== undefined, m ?? "no recording is running");
         return;
       }
       case "unwatch": {
@@ -508,6 +528,7 @@ export class EngineSession {
       onTelemetry: (at) => this.flush(at),
       onFinished: () => {
         this.flush();
+        this.finishRecording();
         this.setState("finished");
       },
     });
@@ -528,6 +549,67 @@ export class EngineSession {
       const m = w.take();
       if (m) this.platform.post(m, [m.t.buffer as ArrayBuffer, m.v.buffer as ArrayBuffer]);
     }
+    this.tickRecording(rt.clock.now());
+  }
+
+  private startRecording(msg: Extract<UiMessage, { type: "record-start" }>): string {
+    const rt = this.requireRuntime();
+    if (this.state !== "running") {
+      throw new Error(
+        "start the pipeline first: a recording takes what the running pipeline sends",
+      );
+    }
+    if (this.recorder) throw new Error("a recording is running already: stop it first");
+    const resources = this.platform.recordings?.(this.file) ?? this.platform.resources(this.file);
+    this.recorder = SessionRecorder.start(rt, msg, this.platform.recordingFormats ?? {}, resources);
+    const status = this.recorder.status(rt.clock.now());
+    this.recordingSentAt = rt.clock.now();
+    this.platform.post({ type: "recording", recording: status });
+    return `recording ${status.outputs.join(", ")} to ${status.file}`;
+  }
+
+  /** Writes what waits; sends the status about 4 times a second; ends a failed recording. */
+  private tickRecording(now: number): void {
+    const r = this.recorder;
+    if (!r) return;
+    r.tick(now);
+    if (r.failed) {
+      this.finishRecording();
+      return;
+    }
+    if (now - this.recordingSentAt < 0.25) return;
+    this.recordingSentAt = now;
+    this.platform.post({ type: "recording", recording: r.status(now) });
+  }
+
+  /**
+   * Finishes the session recording: its last status, and the file's bytes for the page to save
+   * when it was kept in memory. Returns what happened (undefined: none was running).
+   */
+  private finishRecording(): string | undefined {
+    const r = this.recorder;
+    if (!r || !this.rt) return undefined;
+    this.recorder = undefined;
+    const done = r.stop(this.rt.clock.now());
+    const s = done.status;
+    this.platform.post({ type: "recording", recording: s });
+    if (done.bytes) {
+      const name = s.file.split(/[/\\]/).pop() ?? s.file;
+      const bytes = done.bytes;
+      this.platform.post({ type: "download", name, mime: done.mime, bytes }, [
+        bytes.buffer as ArrayBuffer,
+      ]);
+    }
+    const facts = `${s.duration.toFixed(1)} s, ${s.bytes} bytes, ${s.samples} samples`;
+    if (s.state === "failed") {
+      const message = `recording to ${s.file} failed: ${s.error ?? "unknown error"} (${facts} kept)`;
+      this.platform.post({
+        type: "event",
+        event: { t: this.rt.clock.now(), level: "error", block: "recording", message },
+      });
+      return message;
+    }
+    return `${s.inMemory ? "downloading" : "saved"} ${s.file} (${facts})`;
   }
 
   private stop(): void {
@@ -537,11 +619,13 @@ export class EngineSession {
     this.rt.stop();
     this.rt.dispatch();
     this.flush();
+    this.finishRecording();
     this.setState("stopped");
   }
 
   private unload(): void {
     this.stop();
+    this.finishRecording();
     for (const w of this.watches.values()) w.untap();
     this.watches.clear();
     this.rt?.dispose();

@@ -13,7 +13,7 @@ import { EdfStream } from "./edf-stream";
 import { annotationText } from "./edf-writer";
 
 /** Records ahead one input may get of another before the other is padded (about 2 s). */
-const lagRecords = (recordUs: number): number => Math.max(2, Math.ceil(2e6 / recordUs));
+export const lagRecords = (recordUs: number): number => Math.max(2, Math.ceil(2e6 / recordUs));
 const MAX_NUMBERED = 999;
 
 function sizeText(bytes: number): string {
@@ -23,7 +23,7 @@ function sizeText(bytes: number): string {
 }
 
 /** The text of a marker event: `Source=v1,v2` (at most 16 values). */
-function markerText(source: string, f: Frame, i: number): string {
+export function markerText(source: string, f: Frame, i: number): string {
   const n = Math.min(f.stride, 16);
   const parts: string[] = [];
   for (let k = 0; k < n; k++) parts.push(String(f.v[i * f.stride + k]));
@@ -32,7 +32,7 @@ function markerText(source: string, f: Frame, i: number): string {
 }
 
 /** Whether event `i` of `f` differs from the previous one of its input (kept in `last`). */
-function changed(f: Frame, i: number, last: { v: Float64Array | null }): boolean {
+export function changed(f: Frame, i: number, last: { v: Float64Array | null }): boolean {
   const s = f.stride;
   const at = i * s;
   const prev = last.v;
