@@ -20,6 +20,8 @@ import { serveStatic } from "../host/web-server";
 import { runBench } from "./bench";
 import { cmdRepair, repairHelp } from "./repair";
 import { cmdSimulate, simulateHelp } from "./simulate";
+import { NilsPodSimulator } from "../devices/nilspod-simulator";
+import type { BleBridge } from "../engine/io";
 import { renderTable } from "./table";
 
 const VERSION = "0.1.0";
@@ -39,7 +41,7 @@ Usage:
       writes nothing and lists the files that would change (exit 1).
   mosaic run FILE [--duration S] [--clock realtime|virtual] [--json] [--precision]
                   [--batching-ms MS] [--log-dir DIR] [--start T] [--warmup S]
-                  [--simulate-devices [--keep-network]]
+                  [--simulate-devices [--keep-network]] [--simulate-ble nilspod]
       Runs a pipeline and shows a live per-block table: desired and actual rate, status
       (on time, lagging, stumbling, idle), compute time and drops. --json prints one JSON object
       per line instead (telemetry at 20 Hz, events, a final summary). Ctrl-C stops cleanly and
@@ -62,6 +64,8 @@ Usage:
                        became (docs/mosaic-compatibility.md lists them)
         --keep-network  with --simulate-devices: keep the blocks that talk over UDP and ROS
                        (BlenderArm, HannesGUI, UdpSender, ROS), so local receivers get the data
+        --simulate-ble nilspod  a simulated NilsPod behind the Bluetooth LE bridge (no adapter
+                       needed): the NilsPod block finds it and speaks its protocol to it
   mosaic web [--port N] [--host ADDR] [--pipeline FILE]
       Serves the browser build (dist/web: the UI with the engine in the page's Web Worker, on
       simulated signals) and prints its URL; --pipeline preselects one of pipelines/ (default
@@ -107,6 +111,20 @@ const SIMULATE_ARGS = {
   "simulate-devices": { type: "boolean", default: false },
   "keep-network": { type: "boolean", default: false },
 } as const;
+
+/** Peripherals `--simulate-ble` can play behind the host's Bluetooth LE bridge. */
+const SIMULATED_BLE: Record<string, () => BleBridge & { close(): void }> = {
+  nilspod: () => new NilsPodSimulator({ realtime: true }),
+};
+
+/** `--simulate-ble NAME`: the simulated peripheral's bridge, or why not (undefined: off). */
+function bleOption(name: string | undefined): (BleBridge & { close(): void }) | undefined | string {
+  if (name === undefined) return undefined;
+  const make = SIMULATED_BLE[name];
+  return make
+    ? make()
+    : `--simulate-ble: no simulated peripheral '${name}' (peripherals: ${Object.keys(SIMULATED_BLE).join(", ")})`;
+}
 
 async function cmdValidate(args: string[]): Promise<number> {
   let files: string[];
@@ -246,12 +264,18 @@ async function cmdRun(args: string[]): Promise<number> {
       start: { type: "string" },
       warmup: { type: "string" },
       "telemetry-hz": { type: "string" },
+      "simulate-ble": { type: "string" },
       ...SIMULATE_ARGS,
     },
   });
   const simulate = simulateOption(values);
   if (typeof simulate === "string") {
     err(`mosaic run: ${simulate}`);
+    return 2;
+  }
+  const ble = bleOption(values["simulate-ble"]);
+  if (typeof ble === "string") {
+    err(`mosaic run: ${ble}`);
     return 2;
   }
   const file = positionals[0];
@@ -320,6 +344,7 @@ async function cmdRun(args: string[]): Promise<number> {
       telemetryHz,
       ...(mode === "virtual" && duration !== undefined ? { virtualDuration: duration } : {}),
       ...(simulate ? { simulateDevices: simulate } : {}),
+      ...(ble ? { ble } : {}),
     },
     {
       // Only what is used: the JSON lines (printed as the workers encoded them), or the objects
@@ -385,6 +410,7 @@ async function cmdRun(args: string[]): Promise<number> {
   process.off("SIGINT", onSig);
   process.off("SIGTERM", onSig);
   const final = await host.stop();
+  ble?.close();
   latest = final;
   const code = fatal ? 1 : blockErrors > 0 ? 1 : 0;
   if (json) {

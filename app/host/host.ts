@@ -15,6 +15,7 @@ import type { Plan, RuntimeEvent, Telemetry } from "../engine/runtime/runtime";
 import { SabRing } from "../engine/runtime/sab-ring";
 import { serialHub } from "../../native-bridges/serial-proxy";
 import { bleHub } from "../../native-bridges/ble-proxy";
+import type { BleBridge } from "../engine/io";
 import { LogWriter } from "./log-writer";
 import { takeTimeBase } from "./time-base";
 import type {
@@ -42,6 +43,11 @@ export interface HostOptions {
   batchingS?: number;
   /** Replace device blocks by simulators (`--simulate-devices`); undefined: off. */
   simulateDevices?: SimulateOptions;
+  /**
+   * A Bluetooth LE bridge used instead of noble's: a simulated peripheral for demos without an
+   * adapter (`mosaic run --simulate-ble nilspod`); the blocks speak their protocol to it.
+   */
+  ble?: BleBridge;
   workerPath?: string;
   wasmPath?: string;
 }
@@ -136,10 +142,13 @@ export class Host {
 
   private constructor(
     readonly file: string,
-    readonly options: Required<Omit<HostOptions, "logDir" | "batchingS" | "simulateDevices">> & {
+    readonly options: Required<
+      Omit<HostOptions, "logDir" | "batchingS" | "simulateDevices" | "ble">
+    > & {
       logDir: string;
       batchingS: number | undefined;
       simulateDevices: SimulateOptions | undefined;
+      ble: BleBridge | undefined;
     },
   ) {
     this.logWriter = new LogWriter(
@@ -190,6 +199,7 @@ export class Host {
       telemetryHz: opts.telemetryHz ?? 20,
       batchingS: opts.batchingS,
       simulateDevices: opts.simulateDevices,
+      ble: opts.ble,
       workerPath: opts.workerPath ?? defaultWorkerPath(),
       wasmPath: opts.wasmPath ?? defaultWasmPath(),
     });
@@ -367,7 +377,7 @@ export class Host {
       case "ble":
         st.ble ??= bleHub((r) => {
           if (!st.exited) this.post(st, r);
-        });
+        }, this.options.ble);
         st.ble.receive(m);
         break;
       default:

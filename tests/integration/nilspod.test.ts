@@ -27,6 +27,7 @@ import { BlockHarness } from "../../app/engine/testing";
 import { bleHub, bleProxy, type BleReply, type BleRequest } from "../../native-bridges/ble-proxy";
 import { NilsPodSimulator, nilsPodSimRaw } from "../../app/devices/nilspod-simulator";
 import { NilsPod } from "../../app/blocks/devices/nilspod";
+import { jsonLines, requireBuild, runCli } from "./helpers";
 
 const settle = async (): Promise<void> => {
   for (let i = 0; i < 3; i++) await new Promise((r) => setTimeout(r, 0));
@@ -370,5 +371,36 @@ describe("pipelines/devices/nilspod.yaml", () => {
     // 2 s at 102.4 Hz; gravity (≈ 9.8 m/s²) on the simulated forearm's y–z plane.
     expect(Math.abs(imu.length - 205)).toBeLessThanOrEqual(1);
     expect(Math.hypot(imu[0]![1]!, imu[0]![2]!)).toBeGreaterThan(9);
+  });
+});
+
+describe("mosaic run --simulate-ble nilspod", () => {
+  test("the example's NilsPod block finds the simulated peripheral through the host's BLE hub and streams", () => {
+    requireBuild();
+    const r = runCli(
+      [
+        "run",
+        "pipelines/devices/nilspod.yaml",
+        "--simulate-ble",
+        "nilspod",
+        "--duration",
+        "2",
+        "--json",
+      ],
+      { timeoutMs: 30_000 },
+    );
+    expect(r.code, r.stderr).toBe(0);
+    const summary = jsonLines(r.stdout).find((l) => l.type === "summary") as unknown as {
+      blocks: { name: string; events: number; text: string; errors: number }[];
+    };
+    const imu = summary.blocks.find((b) => b.name === "Imu")!;
+    expect(imu.errors).toBe(0);
+    // 102.4 Hz for 2 s, less the scan and connection at the start.
+    expect(Number(/([\d,]+) samples/.exec(imu.text)?.[1]?.replace(/,/g, ""))).toBeGreaterThan(100);
+    const bad = runCli(["run", "pipelines/devices/nilspod.yaml", "--simulate-ble", "myo"]);
+    expect([bad.code, bad.stderr.trim()]).toEqual([
+      2,
+      "mosaic run: --simulate-ble: no simulated peripheral 'myo' (peripherals: nilspod)",
+    ]);
   });
 });
