@@ -279,14 +279,15 @@ async function ready(): Promise<void> {
     onError: problem,
   });
   try {
+    const dataDir =
+      app.commandLine.getSwitchValue("data-dir") || join(app.getPath("documents"), "MOSAIC");
     hub = await SessionHub.start({
       pipelinesDir: layout.pipelinesBase,
       // What the window loads reads and writes only in the examples, the data folder
       // (`--data-dir=DIR`, by default Documents/MOSAIC) and the folders of files opened here.
-      allowedDirs: defaultAllowedDirs(
-        layout.pipelinesBase,
-        app.commandLine.getSwitchValue("data-dir") || join(app.getPath("documents"), "MOSAIC"),
-      ),
+      allowedDirs: defaultAllowedDirs(layout.pipelinesBase, dataDir),
+      // Session recordings (the Record button) go to the data folder's recordings/.
+      dataDir,
       workerPath: layout.sessionWorker,
       wasmPath: layout.wasm,
       // The hub also tells every window (an error event), so no dialog here.

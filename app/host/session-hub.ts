@@ -57,6 +57,11 @@ export interface SessionHubOptions {
    * Undefined: nothing is confined.
    */
   allowedDirs?: string[];
+  /**
+   * The data folder: session recordings (the UI's Record button) go to its `recordings/`
+   * (`mosaic serve --data-dir`, the desktop app's data folder); else to the pipeline's folder.
+   */
+  dataDir?: string;
   /** The session worker died or a log could not be written. */
   onProblem?(message: string): void;
 }
@@ -156,6 +161,7 @@ export class SessionHub {
       wasmPath: options.wasmPath ?? defaultWasmPath(),
       pipelinesDir: options.pipelinesDir,
       timeBase: takeTimeBase(),
+      ...(options.dataDir !== undefined ? { dataDir: resolve(options.dataDir) } : {}),
     });
     this.toWorker({ type: "hello", version: PROTOCOL_VERSION });
   }
@@ -265,6 +271,7 @@ export class SessionHub {
         return;
       case "telemetry":
       case "event":
+      case "recording":
         this.broadcast(m);
         return;
       case "graph":

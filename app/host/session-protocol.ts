@@ -13,6 +13,8 @@ export type HubToSession =
       /** Relative pipeline file names ("pipelines/x.yaml" from the UI's list) resolve here. */
       pipelinesDir: string;
       timeBase: TimeBase;
+      /** Where session recordings (the UI's Record button) go; else the pipeline's folder. */
+      dataDir?: string;
     }
   /**
    * The folders the pipelines loaded from now on may read and write (null: anywhere). The hub

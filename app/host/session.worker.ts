@@ -38,6 +38,7 @@ import { nodeLslBridge } from "../../native-bridges/lsl";
 import { nodeTcpBridge } from "../../native-bridges/tcp";
 import { nodeUdpBridge } from "../../native-bridges/udp";
 import { createPythonBridge } from "../../native-bridges/python";
+import { sessionRecordingFormats } from "../blocks/recording/session-formats";
 import { AllowedFolders, nodeResources } from "./resources";
 import { clockFromBase } from "./time-base";
 import type { HubToSession, SessionToHub } from "./session-protocol";
@@ -306,6 +307,9 @@ function runSession(port: MessagePort): void {
       resources: (file) => nodeResources(folderOf(file), allowed ?? undefined),
       logs: (file) => logSink(file, allowed),
       loadPipeline: parse,
+      recordingFormats: sessionRecordingFormats,
+      // The data folder when there is one, confined as the pipeline is.
+      recordings: (file) => nodeResources(msg.dataDir ?? folderOf(file), allowed ?? undefined),
       io: {
         udp: nodeUdpBridge(),
         tcp: nodeTcpBridge(),

@@ -6,6 +6,7 @@
  */
 /// <reference lib="webworker" />
 import { catalog } from "../blocks/catalog";
+import { sessionRecordingFormats } from "../blocks/recording/session-formats";
 import type { Resources } from "../engine/block";
 import { MonotonicClock } from "../engine/clock";
 import { initDsp } from "../engine/dsp";
@@ -43,8 +44,13 @@ function fetchResources(file: string): Resources {
       if (!r.ok) throw new Error(`cannot read ${url}: HTTP ${r.status}`);
       return r.text();
     },
-    writeText(p: string) {
-      return Promise.reject(new Error(`the browser build cannot write files (asked for '${p}')`));
+    // No files here: the page downloads what a block saves (a Buffer's rows, a model).
+    writeText(p: string, text: string) {
+      const name = p.split(/[/\\]/).pop() || "mosaic.txt";
+      const bytes = new TextEncoder().encode(text);
+      const msg: EngineMessage = { type: "download", name, mime: "text/plain", bytes };
+      self.postMessage(msg, [bytes.buffer]);
+      return Promise.resolve();
     },
   };
 }
@@ -80,6 +86,8 @@ const platform: SessionPlatform = {
   sharedMemory: shared,
   clock: () => new MonotonicClock(),
   resources: fetchResources,
+  // Recordings are kept in memory (no openWrite) and downloaded when they stop.
+  recordingFormats: sessionRecordingFormats,
   startLoop,
   post: (msg: EngineMessage, transfer?: ArrayBuffer[]) => self.postMessage(msg, transfer ?? []),
 };

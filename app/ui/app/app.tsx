@@ -16,6 +16,8 @@ import { EventLog, type LogEntry } from "./event-log";
 import { GestureLegend, useGestureKeys } from "./gestures";
 import { setBlockParam } from "../graph/layout-yaml";
 import { PanelHost, type EditStatic, type OpenPanel } from "./panel-host";
+import { RecordControl } from "./record";
+import { saveFile } from "./save-file";
 import { UiContext, type UiActions } from "./ui-context";
 import { usePipeline, type PipelineEntry } from "./use-pipeline";
 
@@ -142,6 +144,15 @@ function Shell({
       setNotice({ text, level, id: nextId.current });
     },
     [addLog],
+  );
+  // The browser build's engine cannot write files: what it saves comes here to be downloaded.
+  useEffect(
+    () =>
+      client.onDownload((d) => {
+        saveFile(d.name, d.mime, d.bytes);
+        notify(`downloaded ${d.name}`);
+      }),
+    [client, notify],
   );
   useEffect(() => {
     if (!notice) return undefined;
@@ -393,6 +404,7 @@ function Shell({
           <button type="button" onClick={() => void client.stop()} disabled={!running}>
             Stop
           </button>
+          <RecordControl graph={graph} running={running} notify={notify} />
           <span
             className={`engine-state state-${state}`}
             role="status"

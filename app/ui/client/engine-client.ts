@@ -10,6 +10,8 @@ import type {
   EngineMessage,
   EngineState,
   GraphInfo,
+  RecordingFormatName,
+  RecordingStatus,
   UiMessage,
 } from "../../engine/protocol";
 import type { Diagnostic } from "../../engine/diagnostics";
@@ -31,6 +33,13 @@ export interface Reply {
 
 export type DataListener = (m: DataMessage) => void;
 
+/** A file the engine hands the page to save (browser build: recordings, saved models). */
+export interface DownloadFile {
+  name: string;
+  mime: string;
+  bytes: Uint8Array;
+}
+
 export class EngineClient {
   private nextId = 1;
   private readonly pending = new Map<number, (r: Reply) => void>();
@@ -41,10 +50,14 @@ export class EngineClient {
   private readonly helloListeners = new Set<() => void>();
   private readonly graphListeners = new Set<(g: GraphInfo | undefined) => void>();
   private readonly remoteGraphListeners = new Set<(g: GraphInfo) => void>();
+  private readonly recordingListeners = new Set<(r: RecordingStatus) => void>();
+  private readonly downloadListeners = new Set<(d: DownloadFile) => void>();
   private readonly off: () => void;
   telemetry: Telemetry | undefined;
   state: EngineState = "empty";
   graph: GraphInfo | undefined;
+  /** The latest session recording's status (Record button), if any. */
+  recording: RecordingStatus | undefined;
   engineName = "";
   sharedMemory = false;
   /** True once the engine answered `hello`. */
@@ -88,6 +101,13 @@ export class EngineClient {
         this.graph = m.graph;
         for (const l of this.graphListeners) l(this.graph);
         for (const l of this.remoteGraphListeners) l(m.graph);
+        break;
+      case "recording":
+        this.recording = m.recording;
+        for (const l of this.recordingListeners) l(m.recording);
+        break;
+      case "download":
+        for (const l of this.downloadListeners) l(m);
         break;
     }
   }
@@ -143,6 +163,36 @@ export class EngineClient {
 
   invoke(block: string, action: string, arg?: unknown): Promise<Reply> {
     return this.request({ type: "invoke", block, action, ...(arg !== undefined ? { arg } : {}) });
+  }
+
+  /** Records block outputs (default port when `port` is omitted) into one file. */
+  recordStart(
+    outputs: { block: string; port?: string }[],
+    format: RecordingFormatName,
+    file?: string,
+  ): Promise<Reply> {
+    return this.request({
+      type: "record-start",
+      outputs,
+      format,
+      ...(file !== undefined ? { file } : {}),
+    });
+  }
+
+  recordStop(): Promise<Reply> {
+    return this.request({ type: "record-stop" });
+  }
+
+  /** The session recording's status: while it runs (~4 Hz) and when it ends. */
+  onRecording(l: (r: RecordingStatus) => void): () => void {
+    this.recordingListeners.add(l);
+    return () => this.recordingListeners.delete(l);
+  }
+
+  /** A file to save (the browser build's engine cannot write files). */
+  onDownload(l: (d: DownloadFile) => void): () => void {
+    this.downloadListeners.add(l);
+    return () => this.downloadListeners.delete(l);
   }
 
   onTelemetry(l: (t: Telemetry) => void): () => void {
