@@ -15,6 +15,7 @@ import type { Status } from "../../engine/runtime/status";
 import { useEngine } from "../client/hooks";
 import { StatusIcon, STATUS_HELP, statusText } from "../graph/status";
 import { formatValue } from "./channels";
+import { latencyText } from "./latency";
 import { fitCanvas, readTheme, useWidth } from "./canvas";
 import { onFrame } from "./frame";
 import { STATUS_ORDER, StatusHistory } from "./status-history";
@@ -183,7 +184,11 @@ export function StatusView({
             value={`${formatValue(sum.rateMin)}–${formatValue(sum.rateMax)} Hz`}
           />
           <Figure term="Events" value={String(b.events)} />
-          <Figure term="Latency" value={ms(b.latencyMs)} />
+          <Figure
+            term="Latency"
+            value={latencyText(b.latencyMs)}
+            title="Mean of (emission time − timestamp of the newest event of each output); a few µs below zero is the clock's resolution and reads 0"
+          />
           <Figure term="Dropped on inputs" value={String(b.dropsIn)} warn={b.dropsIn > 0} />
           <Figure term="Errors" value={String(b.errors)} warn={b.errors > 0} />
           {b.timer && (
