@@ -12,7 +12,7 @@ import { BlockTable } from "../graph/block-table";
 import { StimulusOverlay } from "../stimulus/stimulus-view";
 import { Editor, EMPTY_FILE } from "../editor/editor";
 import { Diagnostics } from "./diagnostics";
-import { EventLog, type LogEntry } from "./event-log";
+import { EventLog } from "./event-log";
 import { GestureLegend, useGestureKeys } from "./gestures";
 import { setBlockParam } from "../graph/layout-yaml";
 import { PanelHost, type EditStatic, type OpenPanel } from "./panel-host";
@@ -20,8 +20,7 @@ import { RecordControl } from "./record";
 import { saveFile } from "./save-file";
 import { UiContext, type UiActions } from "./ui-context";
 import { usePipeline, type PipelineEntry } from "./use-pipeline";
-
-const MAX_LOG = 500;
+import { useEventLog } from "./use-event-log";
 
 const STATE_LABEL: Record<EngineState, string> = {
   empty: "no pipeline",
@@ -114,34 +113,25 @@ function Shell({
   const reducedMotion = useReducedMotion();
   const running = state === "running";
 
-  // ---- log and notices
-  const [log, setLog] = useState<LogEntry[]>([]);
-  const [logOpen, setLogOpen] = useState(false);
+  // ---- log (per load: its diagnostics, runtime events, replies) and notices
+  const {
+    book: log,
+    open: logOpen,
+    setOpen: setLogOpen,
+    add: addLog,
+    clear: clearLog,
+  } = useEventLog(client, pipeline.onLoadReport);
   const [notice, setNotice] = useState<{
     text: string;
     level: "info" | "error";
     id: number;
   } | null>(null);
   const nextId = useRef(1);
-  const addLog = useCallback((e: Omit<LogEntry, "id">) => {
-    const entry = { ...e, id: nextId.current++ };
-    setLog((l) =>
-      l.length >= MAX_LOG ? [...l.slice(l.length - MAX_LOG + 1), entry] : [...l, entry],
-    );
-  }, []);
-  useEffect(
-    () =>
-      client.onEvent((e) => {
-        addLog(e);
-        if (e.level === "error") setLogOpen(true);
-      }),
-    [client, addLog],
-  );
   const notify = useCallback(
     (message: string, level: "info" | "error" = "info", block = "") => {
       addLog({ t: Date.now() / 1000, level, block, message });
       const text = block && !message.startsWith(block) ? `${block}: ${message}` : message;
-      setNotice({ text, level, id: nextId.current });
+      setNotice({ text, level, id: nextId.current++ });
     },
     [addLog],
   );
@@ -553,10 +543,10 @@ function Shell({
         <footer className="footer">
           <GestureLegend graph={graph} />
           <EventLog
-            entries={log}
+            book={log}
             open={logOpen}
             onToggle={() => setLogOpen((o) => !o)}
-            onClear={() => setLog([])}
+            onClear={clearLog}
           />
         </footer>
 

@@ -1,5 +1,6 @@
 /** The problems of a pipeline file: file:line:col, message, what was expected, a suggestion. */
 import type { Diagnostic } from "../../engine/diagnostics";
+import { countLevels, diagnosticLine, plural } from "./log-book";
 
 export function Diagnostics({
   diagnostics,
@@ -12,13 +13,11 @@ export function Diagnostics({
   failed: boolean;
 }) {
   if (diagnostics.length === 0 && error === undefined) return null;
-  const errors = diagnostics.filter((d) => d.severity === "error").length;
-  const notes = diagnostics.filter((d) => d.severity === "info").length;
-  const warnings = diagnostics.length - errors - notes;
-  const count = (n: number, what: string): string => `${n} ${what}${n === 1 ? "" : "s"}`;
+  // Counted as the Log counts them (one line per diagnostic there).
+  const { errors, warnings, infos: notes } = countLevels(diagnostics.map(diagnosticLine));
   const loaded = [
-    ...(warnings > 0 || notes === 0 ? [count(warnings, "warning")] : []),
-    ...(notes > 0 ? [count(notes, "note")] : []),
+    ...(warnings > 0 || notes === 0 ? [plural(warnings, "warning")] : []),
+    ...(notes > 0 ? [plural(notes, "note")] : []),
   ].join(" and ");
   return (
     <section
@@ -29,7 +28,7 @@ export function Diagnostics({
     >
       <h2>
         {failed ? "The pipeline did not load" : `${loaded} while loading`}
-        {failed && errors > 0 ? ` — ${errors} error${errors === 1 ? "" : "s"}` : ""}
+        {failed && errors > 0 ? ` — ${plural(errors, "error")}` : ""}
       </h2>
       {error !== undefined ? <p className="diagnostics__error">{error}</p> : null}
       <ul>

@@ -1,14 +1,19 @@
-/** The log of runtime events (errors and warnings per block) and of the replies to actions. */
+/**
+ * The log of the current load: its diagnostics, then runtime events (errors and warnings per
+ * block) and the replies to actions; the counts beside it are this load's (./log-book.ts), so
+ * they match the list and start again with every load. Earlier loads are kept, folded away.
+ */
 import { memo } from "react";
+import {
+  countsText,
+  currentCounts,
+  currentEntries,
+  earlierEntries,
+  type LogBook,
+  type LogEntry,
+} from "./log-book";
 
-export interface LogEntry {
-  id: number;
-  /** UNIX seconds. */
-  t: number;
-  level: "error" | "warning" | "info";
-  block: string;
-  message: string;
-}
+export type { LogEntry } from "./log-book";
 
 const time = (t: number): string => {
   const d = new Date(t * 1000);
@@ -18,19 +23,58 @@ const time = (t: number): string => {
 
 const LEVEL_MARK: Record<LogEntry["level"], string> = { error: "✖", warning: "▲", info: "●" };
 
+function Entry({ e }: { e: LogEntry }) {
+  return (
+    <li className={`event-log__entry level-${e.level}`} data-level={e.level}>
+      <span className="event-log__mark" aria-hidden="true">
+        {LEVEL_MARK[e.level]}
+      </span>
+      <time>{time(e.t)}</time>
+      <span className="event-log__level">{e.level}</span>
+      {e.block ? <strong className="event-log__block">{e.block}</strong> : null}
+      <span className="event-log__message">{e.message}</span>
+    </li>
+  );
+}
+
+function Counts({ book }: { book: LogBook }) {
+  const c = currentCounts(book);
+  return (
+    <span
+      className="event-log__counts"
+      data-errors={c.errors}
+      data-warnings={c.warnings}
+      title="Since the pipeline was loaded"
+    >
+      {c.errors > 0 || c.warnings > 0 ? (
+        <>
+          {c.errors > 0 ? (
+            <span className="count-error">{countsText({ ...c, warnings: 0 })}</span>
+          ) : null}
+          {c.warnings > 0 ? (
+            <span className="count-warning">{countsText({ ...c, errors: 0 })}</span>
+          ) : null}
+        </>
+      ) : (
+        <span>{countsText(c)}</span>
+      )}
+    </span>
+  );
+}
+
 function EventLogComponent({
-  entries,
+  book,
   open,
   onToggle,
   onClear,
 }: {
-  entries: readonly LogEntry[];
+  book: LogBook;
   open: boolean;
   onToggle(): void;
   onClear(): void;
 }) {
-  const errors = entries.filter((e) => e.level === "error").length;
-  const warnings = entries.filter((e) => e.level === "warning").length;
+  const current = currentEntries(book);
+  const earlier = earlierEntries(book);
   return (
     <section className={`event-log${open ? " is-open" : ""}`} aria-label="Event log">
       <header className="event-log__head">
@@ -43,40 +87,32 @@ function EventLogComponent({
         >
           <span aria-hidden="true">{open ? "▾" : "▸"}</span> Log
         </button>
-        <span className="event-log__counts" data-errors={errors} data-warnings={warnings}>
-          {errors > 0 ? (
-            <span className="count-error">
-              {errors} error{errors === 1 ? "" : "s"}
-            </span>
-          ) : null}
-          {warnings > 0 ? (
-            <span className="count-warning">
-              {warnings} warning{warnings === 1 ? "" : "s"}
-            </span>
-          ) : null}
-          {errors === 0 && warnings === 0 ? <span>no errors</span> : null}
-        </span>
-        {open && entries.length > 0 ? (
+        <Counts book={book} />
+        {open && book.entries.length > 0 ? (
           <button type="button" className="event-log__clear" onClick={onClear}>
             Clear
           </button>
         ) : null}
       </header>
       {open ? (
-        <ol id="event-log-list" className="event-log__list" aria-live="polite">
-          {entries.length === 0 ? <li className="event-log__empty">Nothing yet.</li> : null}
-          {[...entries].reverse().map((e) => (
-            <li key={e.id} className={`event-log__entry level-${e.level}`} data-level={e.level}>
-              <span className="event-log__mark" aria-hidden="true">
-                {LEVEL_MARK[e.level]}
-              </span>
-              <time>{time(e.t)}</time>
-              <span className="event-log__level">{e.level}</span>
-              {e.block ? <strong className="event-log__block">{e.block}</strong> : null}
-              <span className="event-log__message">{e.message}</span>
-            </li>
-          ))}
-        </ol>
+        <div className="event-log__body">
+          <ol id="event-log-list" className="event-log__list" aria-live="polite">
+            {current.length === 0 ? <li className="event-log__empty">Nothing yet.</li> : null}
+            {[...current].reverse().map((e) => (
+              <Entry key={e.id} e={e} />
+            ))}
+          </ol>
+          {earlier.length > 0 ? (
+            <details className="event-log__earlier">
+              <summary>Earlier loads ({earlier.length})</summary>
+              <ol className="event-log__list">
+                {[...earlier].reverse().map((e) => (
+                  <Entry key={e.id} e={e} />
+                ))}
+              </ol>
+            </details>
+          ) : null}
+        </div>
       ) : null}
     </section>
   );

@@ -7,6 +7,7 @@ import { useCallback, useEffect, useRef, useState } from "react";
 import type { Diagnostic } from "../../engine/diagnostics";
 import type { GraphInfo } from "../../engine/protocol";
 import type { EngineClient, Reply } from "../client/engine-client";
+import type { LoadReport } from "./log-book";
 
 export interface PipelineEntry {
   file: string;
@@ -52,6 +53,20 @@ export function usePipeline(client: EngineClient, initial: string, simulateDevic
     simulateDevices,
   });
   const busy = useRef(0);
+  const reportListeners = useRef(new Set<(r: LoadReport) => void>());
+  const report = useCallback((r: LoadReport) => {
+    for (const l of reportListeners.current) l(r);
+  }, []);
+  /**
+   * What each load reported (diagnostics, a problem outside the file), told synchronously when
+   * its reply arrives: before any runtime event of the pipeline it loaded.
+   */
+  const onLoadReport = useCallback((l: (r: LoadReport) => void) => {
+    reportListeners.current.add(l);
+    return () => {
+      reportListeners.current.delete(l);
+    };
+  }, []);
 
   useEffect(() => {
     let cancelled = false;
@@ -75,6 +90,9 @@ export function usePipeline(client: EngineClient, initial: string, simulateDevic
       setS((p) => ({ ...p, loading: true, file, error: undefined }));
       const r = await client.load(file, source, simulate.current);
       if (ticket !== busy.current) return { ok: false, message: "another load started" };
+      const diagnostics = r.diagnostics ?? [];
+      const error = r.ok || diagnostics.length > 0 ? undefined : (r.message ?? "cannot load");
+      report({ file, diagnostics, ...(error !== undefined ? { error } : {}), replaced: true });
       setS((p) => ({
         ...p,
         loading: false,
@@ -82,13 +100,13 @@ export function usePipeline(client: EngineClient, initial: string, simulateDevic
         source,
         graph: r.graph,
         generation: p.generation + 1,
-        diagnostics: r.diagnostics ?? [],
-        error: r.ok || (r.diagnostics?.length ?? 0) > 0 ? undefined : (r.message ?? "cannot load"),
+        diagnostics,
+        error,
       }));
       if (r.ok && autostart) await client.start();
       return r;
     },
-    [client],
+    [client, report],
   );
 
   /** Fetches a file of the build (relative to the page) and loads it. */
@@ -101,17 +119,14 @@ export function usePipeline(client: EngineClient, initial: string, simulateDevic
         if (!r.ok) throw new Error(`HTTP ${r.status} ${r.statusText}`.trim());
         text = await r.text();
       } catch (e) {
-        setS((p) => ({
-          ...p,
-          file,
-          loading: false,
-          error: `Cannot read ${file}: ${(e as Error).message}`,
-        }));
+        const error = `Cannot read ${file}: ${(e as Error).message}`;
+        report({ file, diagnostics: [], error, replaced: false });
+        setS((p) => ({ ...p, file, loading: false, error }));
         return { ok: false, message: `cannot read ${file}` };
       }
       return loadSource(file, text, autostart);
     },
-    [loadSource],
+    [loadSource, report],
   );
 
   const select = useCallback((file: string) => setS((p) => ({ ...p, selected: file })), []);
@@ -123,25 +138,29 @@ export function usePipeline(client: EngineClient, initial: string, simulateDevic
   }, []);
 
   /** Shows a pipeline the (shared) engine already has, without loading anything. */
-  const adopt = useCallback((graph: GraphInfo) => {
-    busy.current++;
-    simulate.current = graph.simulateDevices === true;
-    setS((p) => ({
-      ...p,
-      loading: false,
-      file: graph.file,
-      selected: graph.file,
-      source: undefined,
-      graph,
-      generation: p.generation + 1,
-      diagnostics: [],
-      error: undefined,
-      simulateDevices: graph.simulateDevices === true,
-    }));
-  }, []);
+  const adopt = useCallback(
+    (graph: GraphInfo) => {
+      busy.current++;
+      simulate.current = graph.simulateDevices === true;
+      report({ file: graph.file, diagnostics: [], adopted: true, replaced: true });
+      setS((p) => ({
+        ...p,
+        loading: false,
+        file: graph.file,
+        selected: graph.file,
+        source: undefined,
+        graph,
+        generation: p.generation + 1,
+        diagnostics: [],
+        error: undefined,
+        simulateDevices: graph.simulateDevices === true,
+      }));
+    },
+    [report],
+  );
 
   // Another client of a shared engine (a tab, the desktop menu) loaded a pipeline: show it.
   useEffect(() => client.onRemoteGraph(adopt), [client, adopt]);
 
-  return { ...s, load, loadSource, select, adopt, setSimulateDevices };
+  return { ...s, load, loadSource, select, adopt, setSimulateDevices, onLoadReport };
 }
