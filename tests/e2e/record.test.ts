@@ -6,6 +6,7 @@
 import { readFileSync } from "node:fs";
 import { afterAll, beforeAll, describe, expect, test } from "vitest";
 import { bytesSource, readXdf } from "../../app/blocks/recording/xdf-reader";
+import type { EngineClient } from "../../app/ui/client/engine-client";
 import {
   artifact,
   haveChromium,
@@ -17,6 +18,7 @@ import {
 } from "./harness";
 
 interface InPage {
+  mosaic: { client: EngineClient };
   document: {
     // eslint-disable-next-line @typescript-eslint/no-explicit-any -- DOM elements, untyped here
     querySelector(selector: string): any;
@@ -109,6 +111,35 @@ describe.skipIf(!haveChromium)("Record button (browser build, Chromium)", () => 
     expect(total).toBe(written);
     // The button is back, and the page reported no error.
     await page.getByRole("button", { name: "Record…" }).waitFor();
+    expect(app.errors).toEqual([]);
+    await app.close();
+  });
+
+  test("Save model in the browser build downloads the model file instead of failing", async () => {
+    const app = await openApp(chromium, served.url, "e2e/save-model.yaml");
+    const { page } = app;
+    const [download, reply] = await Promise.all([
+      page.waitForEvent("download"),
+      page.evaluate(() =>
+        (globalThis as unknown as InPage).mosaic.client.invoke("Predictor", "save"),
+      ),
+    ]);
+    expect(reply).toMatchObject({
+      ok: true,
+      message: /saving the model .* to Predictor\.model\.json/,
+    });
+    expect(download.suggestedFilename()).toBe("Predictor.model.json");
+    const text = readFileSync((await download.path())!, "utf8");
+    expect(JSON.parse(text)).toBeTypeOf("object");
+    expect(text).toContain('"Predictor"');
+    // The block says it saved (no warning that it cannot write files).
+    await page.waitForFunction(() =>
+      /saved to Predictor\.model\.json/.test(
+        (globalThis as unknown as InPage).document.querySelector(
+          '.block-node[data-block="Predictor"]',
+        )?.textContent ?? "",
+      ),
+    );
     expect(app.errors).toEqual([]);
     await app.close();
   });

@@ -104,11 +104,19 @@ class XdfSessionWriter implements RecordingWriter {
 export const xdfSessionFormat: RecordingFormat = {
   extension: "xdf",
   mime: "application/octet-stream",
-  open(file: FileWriteHandle, outputs: readonly RecordedOutput[], now: number): RecordingWriter {
+  plan(outputs: readonly RecordedOutput[]) {
     const planned = planStreams(plannerContext("XdfRecorder", asInputs(outputs)), "double64", {});
-    const infos = planned.map((s, i) => ({ ...s, createdAt: now, uid: `session-${i + 1}-${now}` }));
     const expected = planned.map((s) => Math.ceil(Math.max(s.nominalRate, 1) * 0.2));
-    return new XdfSessionWriter(new XdfFileWriter(file, infos, now, isoTime(now), expected));
+    return {
+      open(file: FileWriteHandle, now: number): RecordingWriter {
+        const infos = planned.map((s, i) => ({
+          ...s,
+          createdAt: now,
+          uid: `session-${i + 1}-${now}`,
+        }));
+        return new XdfSessionWriter(new XdfFileWriter(file, infos, now, isoTime(now), expected));
+      },
+    };
   },
 };
 
@@ -192,10 +200,10 @@ function edfFormat(format: EdfFormat): RecordingFormat {
   return {
     extension: format,
     mime: "application/octet-stream",
-    open(file: FileWriteHandle, outputs: readonly RecordedOutput[]): RecordingWriter {
+    plan(outputs: readonly RecordedOutput[]) {
       const p = edfParams.parse({ Format: format });
       const setup = resolveEdfSetup(plannerContext("EdfRecorder", asInputs(outputs)), p);
-      return new EdfSessionWriter(file, setup);
+      return { open: (file: FileWriteHandle) => new EdfSessionWriter(file, setup) };
     },
   };
 }

@@ -187,6 +187,24 @@ describe("session recording", () => {
       await f.s.handle({ type: "record-start", id: 10 + i, ...req });
       expect(lastReply(f.sent)).toMatchObject({ id: 10 + i, ok: false, message: why });
     }
+    // A host that refuses the file (outside the allowed folders): said, nothing recorded.
+    const refusing = await runningSession({
+      ...noResources,
+      openWrite: (path) => {
+        throw new Error(`${path} is outside the folders this pipeline may write`);
+      },
+    });
+    await refusing.s.handle({
+      type: "record-start",
+      id: 1,
+      outputs: [{ block: "C" }],
+      format: "bdf",
+    });
+    expect(lastReply(refusing.sent)).toMatchObject({
+      ok: false,
+      message: /^recordings\/\d{4}-.*\.bdf is outside the folders/,
+    });
+    expect(statuses(refusing.sent)).toEqual([]);
     await f.s.handle({ type: "record-stop", id: 20 });
     expect(lastReply(f.sent)).toMatchObject({ ok: false, message: "no recording is running" });
     await f.s.handle({ type: "stop", id: 21 });

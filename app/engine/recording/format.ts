@@ -41,10 +41,14 @@ export interface RecordingFormat {
   /** MIME type of a download. */
   readonly mime: string;
   /**
-   * Plans the file (throws when the outputs do not fit the format, e.g. an EDF+ of outputs
-   * without a rate) and writes its beginning to `file`.
+   * Plans the file before any exists (throws when the outputs do not fit the format, e.g. an
+   * EDF+ of outputs without a rate); `open` then writes its beginning to `file`.
    */
-  open(file: FileWriteHandle, outputs: readonly RecordedOutput[], now: number): RecordingWriter;
+  plan(outputs: readonly RecordedOutput[]): PlannedRecording;
+}
+
+export interface PlannedRecording {
+  open(file: FileWriteHandle, now: number): RecordingWriter;
 }
 
 export type RecordingFormats = Readonly<Partial<Record<RecordingFormatName, RecordingFormat>>>;

@@ -141,6 +141,7 @@ export class SessionRecorder {
     const format = formats[req.format];
     if (!format) throw new Error(`this engine cannot record ${req.format.toUpperCase()} files`);
     const outputs = resolveOutputs(rt, req.outputs);
+    const planned = format.plan(outputs);
     const now = rt.clock.now();
     const name = recordingName(req.file, format.extension, now);
     const write = resources.openWrite?.bind(resources);
@@ -148,7 +149,7 @@ export class SessionRecorder {
     const file = write ? openOnDisk((path) => write(path), name) : memory!;
     let writer: RecordingWriter;
     try {
-      writer = format.open(file, outputs, now);
+      writer = planned.open(file, now);
     } catch (e) {
       file.close();
       throw e;
