@@ -2,14 +2,16 @@
  * The Status tab's "Latency" figure: the engine's mean of (emission time − timestamp of the
  * newest event of each frame), never shown below zero.
  *
- * A source paced by a timer stamps its events with the tick's deadline, and the loop fires a tick
- * up to a few microseconds before it (the scheduler's early tolerance: 2 µs, more on the coarse
- * loop) while the page's clock moves in steps of 5 µs (100 µs without cross-origin isolation). So
- * the block that emits in its own tick reads a few microseconds *before* its own timestamps: a
- * "latency" of −5 µs that is an artefact of the clock's resolution, not data from the future.
- * Within a millisecond below zero it reads as 0; further below, the events' timestamps really run
- * ahead of the clock (a device or file clock not on the pipeline's) and the figure says that
- * instead of a negative latency.
+ * Why it read negative ("Latency −5 µs", up to about −0.1 ms in the demo): a source paced by a
+ * timer (the Timer, and the Emg simulator it drives) stamps its events with the tick's deadline,
+ * and the real-time loop fires ticks a little *before* their deadline on purpose: it wakes early
+ * by its learned wake-up overshoot and fires what is due within that margin (the scheduler's
+ * early tolerance, at most 0.2 ms, runtime/loop.ts) rather than sleep again; the page's clock
+ * moves in 5 µs steps besides (100 µs without cross-origin isolation). So a source emitting in
+ * its own tick is up to ~0.2 ms before its own timestamps, and the mean over a telemetry window
+ * can fall below zero. No data comes from the future: within a millisecond below zero the figure
+ * reads 0. Further below, the events' timestamps really run ahead of the pipeline's clock (a
+ * device or file clock not on it) and the figure says that instead of a negative latency.
  */
 
 /** How far below zero still reads as the clock's resolution, ms. */
