@@ -24,7 +24,7 @@ export function lslBridge(ctx: BlockContext): LslBridge | undefined {
   return undefined;
 }
 
-export const nameParam = (what: string) => z.string().max(200).default("").describe(what);
+export const nameParam = (what: string) => z.string().max(200).optional().describe(what);
 
 export const bufferParam = z
   .number()
@@ -55,16 +55,17 @@ export function xpathLiteral(value: string, param: string): string {
  * joined with `and` (at least one of the four is needed).
  */
 export function streamPredicate(p: {
-  Name: string;
-  Type: string;
-  SourceId: string;
-  Predicate: string;
+  Name?: string | undefined;
+  Type?: string | undefined;
+  SourceId?: string | undefined;
+  Predicate?: string | undefined;
 }): string {
-  if (p.Predicate.trim() !== "") return p.Predicate.trim();
+  const predicate = p.Predicate?.trim() ?? "";
+  if (predicate !== "") return predicate;
   const parts: string[] = [];
-  if (p.Name !== "") parts.push(`name=${xpathLiteral(p.Name, "Name")}`);
-  if (p.Type !== "") parts.push(`type=${xpathLiteral(p.Type, "Type")}`);
-  if (p.SourceId !== "") parts.push(`source_id=${xpathLiteral(p.SourceId, "SourceId")}`);
+  if (p.Name) parts.push(`name=${xpathLiteral(p.Name, "Name")}`);
+  if (p.Type) parts.push(`type=${xpathLiteral(p.Type, "Type")}`);
+  if (p.SourceId) parts.push(`source_id=${xpathLiteral(p.SourceId, "SourceId")}`);
   if (parts.length === 0) {
     throw new BlockConfigError(
       "say which stream to read: Name, Type, SourceId or a Predicate such as name='EMG'",

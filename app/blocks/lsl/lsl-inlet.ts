@@ -7,12 +7,12 @@ import { bufferParam, lslBridge, nameParam, streamPredicate } from "./lsl-common
 /** Resolution params shared by both inlets. */
 export const resolveParams = {
   Name: nameParam("Read the stream of this name"),
-  Type: z.string().max(200).default("").describe("… of this content type (EEG, EMG, Markers, …)"),
-  SourceId: z.string().max(200).default("").describe("… with this source id"),
+  Type: z.string().max(200).optional().describe("… of this content type (EEG, EMG, Markers, …)"),
+  SourceId: z.string().max(200).optional().describe("… with this source id"),
   Predicate: z
     .string()
     .max(1000)
-    .default("")
+    .optional()
     .describe(
       "An XPath 1.0 predicate on the stream's description instead of Name/Type/SourceId, e.g. name='EMG' and hostname='lab-pc'",
     ),

@@ -36,7 +36,7 @@ const params = z.strictObject({
   SourceId: z
     .string()
     .max(200)
-    .default("")
+    .optional()
     .describe("A unique id of the source (default mosaic:<block>:<Name>)"),
   BufferSeconds: bufferParam,
 });
@@ -79,7 +79,7 @@ export const LslMarkers = defineBlock({
         "Channel",
       );
     }
-    const name = p.Name !== "" ? p.Name : ctx.name;
+    const name = p.Name || ctx.name;
     const link = new OutletLink(
       ctx,
       {
@@ -88,7 +88,7 @@ export const LslMarkers = defineBlock({
         channels: 1,
         rate: 0,
         format: p.Format,
-        sourceId: p.SourceId !== "" ? p.SourceId : defaultSourceId(ctx, name),
+        sourceId: p.SourceId || defaultSourceId(ctx, name),
       },
       p.BufferSeconds,
     );

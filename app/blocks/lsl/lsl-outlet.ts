@@ -37,7 +37,7 @@ const params = z.strictObject({
   SourceId: z
     .string()
     .max(200)
-    .default("")
+    .optional()
     .describe(
       "A unique id of the source, so that inlets reconnect to it after a restart; default mosaic:<block>:<Name>",
     ),
@@ -84,14 +84,14 @@ export const LslOutlet = defineBlock({
         "ChannelLabels",
       );
     }
-    const name = p.Name !== "" ? p.Name : ctx.name;
+    const name = p.Name || ctx.name;
     const info = {
       name,
       type: p.Type,
       channels,
       rate: p.NominalRate ?? input.rate,
       format: p.Format,
-      sourceId: p.SourceId !== "" ? p.SourceId : defaultSourceId(ctx, name),
+      sourceId: p.SourceId || defaultSourceId(ctx, name),
       labels,
     };
     const link = new OutletLink(ctx, info, p.BufferSeconds);
