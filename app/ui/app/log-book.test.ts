@@ -99,6 +99,7 @@ describe("the event log's counts", () => {
     book = load(book, { file: "p.yaml", diagnostics: [error, warning(2)], replaced: true }, next);
     expect(currentCounts(book)).toMatchObject({ errors: 1, warnings: 1 });
     expect(currentEntries(book)[0]!.message).toBe("p.yaml did not load: 1 error, 1 warning");
+    expect(diagnosticLine({ ...error, file: "pipelines/legacy/p.yaml" }).block).toBe("p.yaml:4:14");
     expect(diagnosticLine(error)).toEqual({
       level: "error",
       block: "p.yaml:4:14",

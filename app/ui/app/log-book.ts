@@ -96,9 +96,13 @@ const LEVEL_OF: Record<Diagnostic["severity"], LogLevel> = {
   info: "info",
 };
 
+/** "demo.yaml" for "pipelines/demo.yaml" (the Log's narrow column; the banner has the path). */
+const baseName = (file: string): string => file.split(/[/\\]/).pop() || file;
+
 /** A diagnostic as one line of the log: where (file:line:col) and what, as the banner says it. */
 export function diagnosticLine(d: Diagnostic): { level: LogLevel; block: string; message: string } {
-  const where = d.line > 0 ? `${d.file}:${d.line}:${d.col}` : d.file;
+  const file = baseName(d.file);
+  const where = d.line > 0 ? `${file}:${d.line}:${d.col}` : file;
   let message = d.message;
   if (d.expected !== undefined) message += ` (expected ${d.expected})`;
   if (d.suggestion !== undefined) message += `; did you mean '${d.suggestion}'?`;
