@@ -173,6 +173,40 @@ describe("session recording", () => {
     expect(lastReply(f.sent)).toMatchObject({ message: "recording C to recordings/rec_2.edf" });
   });
 
+  test("a write that fails (disk full) ends the recording with an error; the pipeline goes on", async () => {
+    let file: MemoryFile | undefined;
+    const f = await runningSession({
+      ...noResources,
+      openWrite(path: string): FileWriteHandle {
+        file = new MemoryFile(path);
+        const write = file.write.bind(file);
+        file.write = (bytes) => {
+          if (file!.size + bytes.length > 4000) throw new Error("the disk is full");
+          write(bytes);
+        };
+        return file;
+      },
+    });
+    await f.s.handle({ type: "record-start", id: 3, outputs: [{ block: "G" }], format: "xdf" });
+    expect(lastReply(f.sent)).toMatchObject({ ok: true });
+    f.advance(2);
+    const last = statuses(f.sent).at(-1)!;
+    expect(last).toMatchObject({ state: "failed", error: "the disk is full" });
+    expect(last.bytes).toBeLessThanOrEqual(4000);
+    expect(file!.closed).toBe(true);
+    const event = f.sent.find((m) => m.type === "event" && m.event.block === "recording");
+    expect(event).toMatchObject({ event: { level: "error", message: /failed: the disk is full/ } });
+    // What was written before the failure is whole chunks: it reads back without its footer.
+    const xdf = readXdf(bytesSource(file!.bytes));
+    expect(xdf.problem).toBe("");
+    expect(xdf.streams[0]!.t.length).toBeGreaterThan(0);
+    // The pipeline still runs, and a new recording can start.
+    f.advance(0.5);
+    expect(f.sent.filter((m) => m.type === "state").at(-1)).toMatchObject({ state: "running" });
+    await f.s.handle({ type: "record-start", id: 4, outputs: [{ block: "G" }], format: "xdf" });
+    expect(lastReply(f.sent)).toMatchObject({ id: 4, ok: true });
+  });
+
   test("refusals say why and leave the pipeline running", async () => {
     const f = await runningSession(noResources);
     const tries = [
