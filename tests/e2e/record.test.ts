@@ -66,6 +66,7 @@ describe.skipIf(!haveChromium)("Record button (browser build, Chromium)", () => 
     expect(await dialog.getByRole("checkbox", { name: /^LowPass\b/ }).isChecked()).toBe(false);
     await dialog.getByRole("checkbox", { name: /^LowPass\b/ }).check();
     expect(await dialog.getByRole("radio", { name: "XDF" }).isChecked()).toBe(true);
+    expect(await dialog.textContent()).toContain("downloaded when you stop it");
     await page.screenshot({ path: artifact("record-dialog.png") });
     await dialog.getByRole("button", { name: "Start recording" }).click();
     await dialog.waitFor({ state: "detached" });

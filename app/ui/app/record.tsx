@@ -6,7 +6,7 @@
  */
 import { useEffect, useId, useMemo, useRef, useState } from "react";
 import type { GraphInfo, RecordingFormatName, RecordingStatus } from "../../engine/protocol";
-import { useEngine } from "../client/hooks";
+import { useEngine, useEngineInfo } from "../client/hooks";
 
 /** Blocks whose outputs are recorded unless the user picks others: what acquires the signals. */
 const ACQUISITION = new Set(["Devices", "Sources"]);
@@ -78,6 +78,8 @@ function RecordDialog({
   onClose(): void;
 }) {
   const ref = useRef<HTMLDialogElement>(null);
+  // The browser build's engine runs in the page and cannot write files.
+  const inPage = useEngineInfo().engine.startsWith("browser");
   const outputs = useMemo(() => recordableOutputs(graph), [graph]);
   const [chosen, setChosen] = useState<Set<string>>(
     () => new Set(outputs.filter((o) => o.acquisition).map((o) => o.key)),
@@ -142,6 +144,11 @@ function RecordDialog({
             </label>
           ))}
         </fieldset>
+        <p className="record-dialog__where">
+          {inPage
+            ? "Kept in memory while it records, downloaded when you stop it."
+            : "Written to recordings/ in the data folder (else the pipeline's folder) as it records."}
+        </p>
         <div className="record-dialog__buttons">
           <button type="button" onClick={onClose}>
             Cancel
