@@ -131,7 +131,8 @@ describe("without --simulate-devices", () => {
           ? /Trigno Control Utility at 127\.0\.0\.1:50040 not reachable: .* --simulate-devices/
           : w.block === "forces" // DLR_ADCBT speaks its protocol: there is no COM7 here
             ? /DLR ADC\/BT: cannot open COM7: .* --simulate-devices/
-            : /not reachable: this version cannot talk to .* --simulate-devices/,
+            : // NilsPod speaks its protocol: there is no Bluetooth adapter here
+              /^NilsPod: .* --simulate-devices\)?$/,
       );
     }
     const summary = jsonLines(r.stdout).find((l) => l.type === "summary") as {

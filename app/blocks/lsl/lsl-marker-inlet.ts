@@ -4,12 +4,14 @@ import { TextThrottle } from "../shared/text";
 import { InletLink } from "./inlet-link";
 import { resolveParams } from "./lsl-inlet";
 import { lslBridge, streamPredicate } from "./lsl-common";
+import { MAX_ITEMS } from "../shared/limits";
 
 const params = z.strictObject({
   ...resolveParams,
   Type: resolveParams.Type.default("Markers"),
   Labels: z
     .array(z.string().max(200))
+    .max(MAX_ITEMS)
     .default([])
     .describe(
       "String markers: the value emitted for marker Labels[k] is k; others are read as numbers, NaN when they are not (counted)",

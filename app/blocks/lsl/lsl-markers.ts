@@ -2,6 +2,7 @@ import { z } from "zod";
 import { BlockConfigError, defineBlock, formatShape, type Frame } from "../../engine";
 import { formatCount, TextThrottle } from "../shared/text";
 import { bufferParam, defaultSourceId, nameParam, OutletLink } from "./lsl-common";
+import { MAX_ITEMS } from "../shared/limits";
 
 const params = z.strictObject({
   Name: nameParam("The marker stream's name (default: this block's name)"),
@@ -22,6 +23,7 @@ const params = z.strictObject({
     .describe("Which value of each input event is the marker (0: the first)"),
   Labels: z
     .array(z.string().max(200))
+    .max(MAX_ITEMS)
     .default([])
     .describe(
       "string: the marker sent for value k is Labels[k] (a Trigger's or Stimulus's label index); values without a label go as their number",

@@ -9,6 +9,7 @@ import {
   OutletLink,
   toIntegerFormat,
 } from "./lsl-common";
+import { MAX_CHANNELS } from "../shared/limits";
 
 const params = z.strictObject({
   Name: nameParam(
@@ -27,6 +28,7 @@ const params = z.strictObject({
     ),
   ChannelLabels: z
     .array(z.string().max(200))
+    .max(MAX_CHANNELS)
     .optional()
     .describe("One label per channel (the input's values in row-major order); default Ch1, Ch2, …"),
   NominalRate: z

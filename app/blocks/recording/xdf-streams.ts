@@ -6,6 +6,7 @@ import { z } from "zod";
 import { BlockConfigError, type BlockContext, type InputInfo } from "../../engine";
 import { signalInput } from "../shared/inputs";
 import type { ChannelFormat, NumericFormat, StreamInfo } from "./xdf-writer";
+import { MAX_CHANNELS } from "../shared/limits";
 
 export const streamSettings = z.strictObject({
   Name: z.string().min(1).optional().describe("Stream name (default: the input as written)"),
@@ -17,7 +18,8 @@ export const streamSettings = z.strictObject({
       "Content type, e.g. EMG, EEG, Markers (default: Markers for events, else the source block's type)",
     ),
   Labels: z
-    .array(z.string())
+    .array(z.string().max(200))
+    .max(MAX_CHANNELS)
     .optional()
     .describe("One label per channel (default: the source's channel names, else ch1, ch2, …)"),
   Unit: z
