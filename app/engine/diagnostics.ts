@@ -22,9 +22,15 @@ export interface Diagnostic {
   suggestion?: string;
 }
 
+/** `file:line:col: severity: text` as `mosaic validate` prints it. */
 export function formatDiagnostic(d: Diagnostic): string {
   const where = d.line > 0 ? `${d.file}:${d.line}:${d.col}` : d.file;
-  let s = `${where}: ${d.severity}: ${d.message}`;
+  return `${where}: ${d.severity}: ${diagnosticText(d)}`;
+}
+
+/** The message with what was expected and the closest valid name (the editor shows this). */
+export function diagnosticText(d: Diagnostic): string {
+  let s = d.message;
   if (d.expected !== undefined) s += ` (expected ${d.expected})`;
   if (d.suggestion !== undefined) s += `; did you mean '${d.suggestion}'?`;
   return s;

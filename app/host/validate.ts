@@ -2,12 +2,10 @@
 import { readFileSync } from "node:fs";
 import { dirname, resolve } from "node:path";
 import { catalog } from "../blocks/catalog";
-import { VirtualClock } from "../engine/clock";
 import type { Diagnostic } from "../engine/diagnostics";
 import { dspReady, initDsp } from "../engine/dsp";
-import { loadPipeline } from "../engine/pipeline/loader";
-import { withSimulatedDevices, type SimulateOptions } from "../engine/pipeline/simulate";
-import { Runtime } from "../engine/runtime/runtime";
+import type { SimulateOptions } from "../engine/pipeline/simulate";
+import { validatePipeline } from "../engine/validate";
 import { defaultWasmPath } from "./host";
 import { nodeResources } from "./resources";
 
@@ -16,7 +14,7 @@ export function loadDspFromDisk(path = defaultWasmPath()): void {
   if (!dspReady()) initDsp(readFileSync(path));
 }
 
-/** Parse, validate, then instantiate every block (shapes, files it reads) and dispose it again. */
+/** Reads the file and checks it as the engine does (app/engine/validate.ts). */
 export async function validatePipelineFile(
   file: string,
   simulateDevices?: SimulateOptions,
@@ -37,21 +35,9 @@ export async function validatePipelineFile(
       },
     ];
   }
-  const loaded = withSimulatedDevices(
-    loadPipeline(source, file, catalog),
-    catalog,
-    simulateDevices,
-  );
-  if (!loaded.spec) return loaded.diagnostics;
   loadDspFromDisk();
-  const created = await Runtime.create({
-    spec: loaded.spec,
-    catalog,
-    clock: new VirtualClock(0),
-    virtual: true,
+  return validatePipeline(source, file, catalog, {
     resources: nodeResources(dirname(resolve(file))),
-    ignorePlacement: true,
+    ...(simulateDevices ? { simulateDevices } : {}),
   });
-  created.runtime?.dispose();
-  return [...loaded.diagnostics, ...created.diagnostics];
 }

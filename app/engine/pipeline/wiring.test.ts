@@ -42,6 +42,17 @@ describe("wiring stage", () => {
     expect(d.inputs.map((i) => i.port)).toEqual(["a", "b"]);
   });
 
+  test("the noun agrees with the number it ends on", () => {
+    expect(wire([block("D", "Drain", [])])).toEqual([
+      "p.yaml:9:9: error: block 'D' (Drain) has 0 inputs (expected at least 1 input)",
+    ]);
+    const t = block("T", "Tick", []);
+    const g = block("G", "Gain", [input("T", 3), input("T", 5), input("T", 7)]);
+    expect(wire([t, g])).toEqual([
+      "p.yaml:9:9: error: block 'G' (Gain) has 3 inputs (expected between 1 and 2 inputs)",
+    ]);
+  });
+
   test("missing blocks and ports, with suggestions; blocks with their own errors are not repeated", () => {
     const t = block("Timer", "Tick", []);
     const h = block("H", "Halves", [input("Timer", 3)], ["a", "b"]);

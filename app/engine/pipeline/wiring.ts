@@ -74,6 +74,8 @@ export function checkWiring(
           : max === Infinity
             ? `at least ${min}`
             : `between ${min} and ${max}`;
+      // The noun agrees with the number it ends on: "at least 1 input", "between 1 and 2 inputs".
+      const last = max === Infinity ? min : max;
       const labels = b.def.inputs.labels ? ` (${b.def.inputs.labels.join(", ")})` : "";
       c.error(
         "input-count",
@@ -81,7 +83,7 @@ export function checkWiring(
         `block '${b.name}' (${b.type}) has ${n} input${n === 1 ? "" : "s"}`,
         {
           block: b.name,
-          expected: `${want} input${max === 1 ? "" : "s"}${labels}`,
+          expected: `${want} input${last === 1 ? "" : "s"}${labels}`,
         },
       );
     }
