@@ -38,6 +38,13 @@ export const uiMessageSchema = z.discriminatedUnion("type", [
      */
     simulateDevices: z.boolean().optional(),
   }),
+  /** The diagnostics `mosaic validate` gives for this text (the editor's); loads nothing. */
+  z.strictObject({
+    type: z.literal("validate"),
+    id,
+    file: z.string().min(1).max(4096),
+    source: z.string().max(4_000_000),
+  }),
   z.strictObject({ type: z.literal("start"), id }),
   /** Every block type the engine knows, with its metadata (the editor's palette and forms). */
   z.strictObject({ type: z.literal("catalog"), id }),

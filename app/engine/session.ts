@@ -30,6 +30,7 @@ import type { Resources } from "./block";
 import type { IoBridges } from "./io";
 import type { RecordingFormats } from "./recording/format";
 import { SessionRecorder } from "./recording/session-recorder";
+import { validatePipeline } from "./validate";
 
 export interface LoopHandle {
   stop(): void;
@@ -305,6 +306,16 @@ export class EngineSession {
           diagnostics,
           ...(graph ? { graph } : {}),
         });
+        return;
+      }
+      case "validate": {
+        // What `mosaic validate` says of the text (app/engine/validate.ts); the running pipeline stays.
+        const parse = this.platform.loadPipeline?.bind(this.platform);
+        const diagnostics = await validatePipeline(msg.source, msg.file, this.catalog, {
+          resources: this.platform.resources(msg.file),
+          ...(parse ? { parse } : {}),
+        });
+        this.reply(msg.id, true, undefined, { diagnostics });
         return;
       }
       case "catalog":

@@ -212,10 +212,15 @@ export class SessionHub {
   }
 
   /**
-   * Sends request `id` (a `load`, pending already) once the loads before it are answered, after
-   * the folders it may use (`dirs`, null: anywhere).
+   * Sends request `id` (a `load` or a `validate`, which reads files as a load does; pending
+   * already) once the loads before it are answered, after the folders it may use (`dirs`, null:
+   * anywhere).
    */
-  private sendLoad(id: number, msg: Extract<UiMessage, { type: "load" }>, dirs: string[] | null) {
+  private sendLoad(
+    id: number,
+    msg: Extract<UiMessage, { type: "load" | "validate" }>,
+    dirs: string[] | null,
+  ) {
     this.loads = this.loads.then(
       () =>
         new Promise<void>((done) => {
@@ -383,7 +388,7 @@ export class SessionHub {
   private forward(client: Client, msg: Extract<UiMessage, { id: number }>): void {
     const id = this.nextId++;
     this.pending.set(id, { client, clientId: msg.id });
-    if (msg.type === "load") {
+    if (msg.type === "load" || msg.type === "validate") {
       this.sendLoad(id, msg, this.allowed ? [...this.allowed] : null);
       return;
     }
