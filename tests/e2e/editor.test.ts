@@ -54,7 +54,14 @@ async function dropBlock(page: Page, type: string, x: number, y: number): Promis
   await page.waitForSelector(`.edit-canvas .react-flow__node[data-id="${type}"]`);
 }
 
+/** Waits until the engine has checked the text on screen (the problems shown are its). */
+async function checked(page: Page): Promise<void> {
+  await page.waitForSelector('.editor[data-checking="false"]');
+}
+
 async function connect(page: Page, from: string, to: string): Promise<void> {
+  // The check of the last edit may still resize the nodes (their problems): wait for it.
+  await checked(page);
   const a = (await page
     .locator(`.edit-canvas .react-flow__node[data-id="${from}"] .react-flow__handle.source`)
     .boundingBox())!;
@@ -111,6 +118,7 @@ describe.skipIf(!haveChromium)("edit mode, end to end (Chromium)", () => {
       "pipelines/examples/training.yaml",
     );
     await page.waitForSelector('.edit-canvas .block-node[data-block="Cues"]');
+    await checked(page);
     expect(await page.getAttribute(".editor", "data-errors")).toBe("0");
     await page.selectOption('select[aria-label="New pipeline from an example"]', "(empty)");
     await page.waitForSelector(".edit-canvas__hint");
@@ -122,6 +130,7 @@ describe.skipIf(!haveChromium)("edit mode, end to end (Chromium)", () => {
     for (let i = 0; i + 1 < CHAIN.length; i++) await connect(page, CHAIN[i]!, CHAIN[i + 1]!);
 
     // Problems are shown until the params and the timer's rate are set.
+    await checked(page);
     expect(Number(await page.getAttribute(".editor", "data-errors"))).toBeGreaterThan(0);
     expect(await page.isDisabled('button:has-text("Save…")')).toBe(true);
     await select(page, "ScheduledTimer");
@@ -214,6 +223,7 @@ describe.skipIf(!haveChromium)("edit mode, end to end (Chromium)", () => {
     const { page } = app;
     await page.click('button:has-text("Edit")');
     await page.waitForSelector('.edit-canvas .react-flow__node[data-id="Device"]');
+    await checked(page);
     expect(await page.getAttribute(".editor", "data-errors")).toBe("0");
     await select(page, "Device");
     // The inspector refuses a reference to a block that does not exist: shown, never written.
@@ -317,6 +327,7 @@ describe.skipIf(!haveChromium)("edit mode, end to end (Chromium)", () => {
     const pane = (await page.locator(".edit-canvas .react-flow__pane").boundingBox())!;
     await dropBlock(page, "Sink", pane.width - 160, pane.height - 120);
     await connect(page, "Decoder", "Sink");
+    await checked(page);
     expect(await page.getAttribute(".editor", "data-dirty")).toBe("true");
     expect(await page.textContent(".editor__state")).toBe("changes not applied");
     await page.evaluate(() => {

@@ -2,7 +2,9 @@
  * Edit mode (issue 8): palette, canvas, inspector and the YAML side by side, all on one text
  * (the pipeline file) through the document model. Structural edits reach the engine with
  * "Apply" (the pipeline is loaded again and started: a short, visible restart); live params of a
- * running block apply at once. "Save…" downloads the file; invalid edits block Apply and Save.
+ * running block apply at once. "Save…" downloads the file. The engine checks every text as
+ * `mosaic validate` does (use-validation.ts); a text with errors, or not checked yet, is neither
+ * applied nor saved.
  */
 import { useCallback, useEffect, useMemo, useRef, useState, type ReactNode } from "react";
 import type { Diagnostic } from "../../engine/diagnostics";
@@ -16,6 +18,7 @@ import { typeIndex, type EditIssue } from "./model";
 import { Palette } from "./palette";
 import { TextView } from "./text-view";
 import { useEditor } from "./use-editor";
+import { issueFromDiagnostic, useValidation } from "./use-validation";
 
 export interface TemplateEntry {
   file: string;
@@ -43,13 +46,16 @@ export interface EditorProps {
 
 export const EMPTY_FILE = "pipelines/untitled.yaml";
 
-const fromDiagnostic = (d: Diagnostic): EditIssue => ({
-  severity: d.severity === "error" ? "error" : "warning",
-  message: d.message + (d.suggestion !== undefined ? ` (did you mean '${d.suggestion}'?)` : ""),
-  ...(d.block !== undefined ? { block: d.block } : {}),
-  line: d.line,
-  col: d.col,
-});
+/** The checked problems, then those of the last Apply of the same text that they lack. */
+function withApplied(issues: EditIssue[], applied: readonly Diagnostic[]): EditIssue[] {
+  const key = (i: EditIssue): string => `${i.line}:${i.col}:${i.message}`;
+  const seen = new Set(issues.map(key));
+  const extra = applied
+    .filter((d) => d.severity !== "info")
+    .map(issueFromDiagnostic)
+    .filter((i) => !seen.has(key(i)));
+  return extra.length > 0 ? [...issues, ...extra] : issues;
+}
 
 export function Editor(props: EditorProps): ReactNode {
   const { client, graph, running, applying, onNotify } = props;
@@ -65,7 +71,8 @@ export function Editor(props: EditorProps): ReactNode {
     };
   }, [client, onNotify]);
 
-  const ed = useEditor(props.initialText, props.initialFile, catalog);
+  const ed = useEditor(props.initialText, props.initialFile);
+  const check = useValidation(client, ed.file, ed.text);
   const [selected, setSelected] = useState<string | null>(null);
   const [selectedEdge, setSelectedEdge] = useState<string | null>(null);
   const [applied, setApplied] = useState<{ text: string; diagnostics: Diagnostic[] }>({
@@ -78,16 +85,12 @@ export function Editor(props: EditorProps): ReactNode {
   const { onDraft } = props;
   useEffect(() => onDraft?.(ed.file, ed.text), [onDraft, ed.file, ed.text]);
 
-  // The engine's problems with the last applied text count while the text is the same.
+  // What `mosaic validate` says of the text (the engine checks it), and what the last Apply of
+  // the same text added (a load instantiates with the real devices' bridges).
   const issues = useMemo(
     () =>
-      applied.text === ed.text && applied.diagnostics.length > 0
-        ? [
-            ...ed.issues,
-            ...applied.diagnostics.filter((d) => d.severity !== "info").map(fromDiagnostic),
-          ]
-        : ed.issues,
-    [ed.issues, ed.text, applied],
+      applied.text === ed.text ? withApplied(check.issues, applied.diagnostics) : check.issues,
+    [check.issues, ed.text, applied],
   );
   const errors = issues.filter((i) => i.severity === "error").length;
   const dirty = applied.text !== ed.text;
@@ -223,6 +226,7 @@ export function Editor(props: EditorProps): ReactNode {
       className="editor"
       data-dirty={String(dirty)}
       data-errors={errors}
+      data-checking={String(check.checking)}
       data-broken={String(ed.broken)}
     >
       <div className="editor__bar" role="toolbar" aria-label="Editor">
@@ -279,7 +283,11 @@ export function Editor(props: EditorProps): ReactNode {
           className="primary"
           onClick={() => void apply()}
           disabled={
-            applying || errors > 0 || ed.blocks.length === 0 || (!dirty && graph !== undefined)
+            applying ||
+            errors > 0 ||
+            check.checking ||
+            ed.blocks.length === 0 ||
+            (!dirty && graph !== undefined)
           }
           title="Load the edited pipeline and start it (a short restart)"
         >
@@ -288,8 +296,14 @@ export function Editor(props: EditorProps): ReactNode {
         <button
           type="button"
           onClick={save}
-          disabled={errors > 0}
-          title={errors > 0 ? "Fix the problems first" : "Download the pipeline file"}
+          disabled={errors > 0 || check.checking}
+          title={
+            errors > 0
+              ? "Fix the problems first"
+              : check.checking
+                ? "The text is being checked"
+                : "Download the pipeline file"
+          }
         >
           Save…
         </button>

@@ -1,14 +1,10 @@
 /**
  * What the editor shows of a pipeline's text: the blocks as written (type, inputs, params,
- * DesiredRate, Path, Layout) and the problems that can be found without the engine — YAML
- * errors, unknown types, bad names, dangling inputs (a block or port that does not exist), the
- * number of inputs, a timer without DesiredRate, params that do not match the type's schema.
- * The engine's loader has the last word when the pipeline is applied; these checks only keep
- * invalid edits from being saved or applied.
+ * DesiredRate, Path, Layout), and whether the text parses at all. Its problems are not judged
+ * here: the engine checks every text as `mosaic validate` does (use-validation.ts).
  */
 import { LineCounter, parseDocument, isMap, isScalar, type Pair } from "yaml";
 import type { BlockTypeInfo, CatalogInfo } from "../../engine/protocol";
-import { validate as validateValue, formatPath, type JsonSchema } from "../forms/schema";
 
 export interface EditInput {
   /** As written, without the leading '-': "Block" or "Block.port". */
@@ -46,8 +42,6 @@ export interface ReadResult {
   /** YAML syntax errors: the text does not parse (the canvas keeps the last good blocks). */
   errors: EditIssue[];
 }
-
-export const BLOCK_NAME = /^[A-Za-z_][A-Za-z0-9_-]*$/;
 
 function keyOf(pair: Pair): unknown {
   return isScalar(pair.key) ? pair.key.value : pair.key;
@@ -136,69 +130,4 @@ export function typeIndex(catalog: CatalogInfo | undefined): Map<string, BlockTy
     for (const a of t.aliases) m.set(a, t);
   }
   return m;
-}
-
-/** Problems the editor can see without the engine (see the file's comment). */
-export function checkBlocks(
-  blocks: readonly EditBlock[],
-  catalog: CatalogInfo | undefined,
-): EditIssue[] {
-  const types = typeIndex(catalog);
-  const byName = new Map(blocks.map((b) => [b.name, b]));
-  const issues: EditIssue[] = [];
-  for (const b of blocks) {
-    const at = { block: b.name, line: b.line, col: 1 };
-    const err = (message: string, field?: string): void => {
-      issues.push({ severity: "error", message, ...at, ...(field ? { field } : {}) });
-    };
-    if (!BLOCK_NAME.test(b.name))
-      err(`'${b.name}' is not a valid block name (letters, digits, '_' or '-')`);
-    if (b.type === "") {
-      err(`block '${b.name}' has no Type`, "Type");
-      continue;
-    }
-    const t = types.get(b.type);
-    if (catalog && !t) {
-      err(`block '${b.name}': unknown type '${b.type}'`, "Type");
-      continue;
-    }
-    b.inputs.forEach((inp, i) => {
-      const src = byName.get(inp.block);
-      if (!src) {
-        err(`block '${b.name}': input ${i + 1} '${inp.source}' is not a block`, "Inputs");
-        return;
-      }
-      if (inp.port !== "") {
-        const st = types.get(src.type);
-        if (st && st.outputs.length > 0 && !st.outputs.includes(inp.port))
-          err(
-            `block '${b.name}': '${inp.block}' has no output '${inp.port}' (${st.outputs.join(", ")})`,
-            "Inputs",
-          );
-      }
-    });
-    if (!t) continue;
-    const n = b.inputs.length;
-    const { min, max } = t.inputs;
-    if (n < min || (max !== null && n > max)) {
-      const want = max === null ? `at least ${min}` : min === max ? `${min}` : `${min} to ${max}`;
-      err(
-        `block '${b.name}' (${t.type}) takes ${want} input${want === "1" ? "" : "s"}, not ${n}`,
-        "Inputs",
-      );
-    }
-    if (t.requiresRate && b.desiredRate === undefined)
-      err(`block '${b.name}' (${t.type}) needs a DesiredRate`, "DesiredRate");
-    if (b.desiredRate !== undefined && !(b.desiredRate > 0))
-      err(`block '${b.name}': DesiredRate must be a positive number of Hz`, "DesiredRate");
-    const schema = t.paramsSchema as JsonSchema;
-    for (const issue of validateValue(schema, b.params)) {
-      const where = formatPath(issue.path);
-      err(
-        `block '${b.name}': ${where ? `${where}: ` : "Params: "}${issue.message}`,
-        where ? `Params.${String(issue.path[0])}` : "Params",
-      );
-    }
-  }
-  return issues;
 }

@@ -1,7 +1,8 @@
 /**
  * The pipeline's YAML beside the canvas (CodeMirror 6): syntax highlighting, completion of block
  * types, block keys, param names (from the engine's catalog) and input names, and the problems
- * inline (the editor's checks, and the engine's after an Apply). Typing replaces the editor's
+ * inline (the engine's check of the text, as `mosaic validate` says it, and what an Apply added),
+ * set as they arrive. Typing replaces the editor's
  * text, so the canvas follows whenever it parses; canvas edits replace what it shows. Undo and
  * redo are the editor's (one history for both sides). Problems are also listed under it;
  * clicking one puts the cursor on its line.
@@ -15,9 +16,9 @@ import { defaultKeymap, indentWithTab } from "@codemirror/commands";
 import { yaml } from "@codemirror/lang-yaml";
 import { defaultHighlightStyle, syntaxHighlighting } from "@codemirror/language";
 import {
-  forceLinting,
   linter,
   lintGutter,
+  setDiagnostics,
   type Diagnostic as LintDiagnostic,
 } from "@codemirror/lint";
 import { Annotation, EditorState } from "@codemirror/state";
@@ -50,6 +51,16 @@ function lineOffset(state: EditorState, line: number, col: number): { from: numb
   return { from, to: from < l.to ? l.to : from };
 }
 
+/** The positioned issues as CodeMirror's lint diagnostics. */
+function lintOf(state: EditorState, issues: readonly EditIssue[]): LintDiagnostic[] {
+  return issues
+    .filter((i) => i.line > 0)
+    .map((i) => {
+      const { from, to } = lineOffset(state, i.line, i.col);
+      return { from, to, severity: i.severity, message: i.message };
+    });
+}
+
 export function TextView({ text, issues, catalog, onChange }: TextViewProps): ReactNode {
   const host = useRef<HTMLDivElement>(null);
   const view = useRef<EditorView | null>(null);
@@ -75,16 +86,9 @@ export function TextView({ text, issues, catalog, onChange }: TextViewProps): Re
                 completeAt(ctx.state.doc.toString(), ctx.pos, latest.current.catalog),
             ],
           }),
-          linter(
-            (ev): LintDiagnostic[] =>
-              latest.current.issues
-                .filter((i) => i.line > 0)
-                .map((i) => {
-                  const { from, to } = lineOffset(ev.state, i.line, i.col);
-                  return { from, to, severity: i.severity, message: i.message };
-                }),
-            { delay: 150 },
-          ),
+          linter((ev): LintDiagnostic[] => lintOf(ev.state, latest.current.issues), {
+            delay: 150,
+          }),
           lintGutter(),
           keymap.of([...defaultKeymap, indentWithTab]),
           EditorView.contentAttributes.of({ "aria-label": "Pipeline YAML" }),
@@ -123,8 +127,10 @@ export function TextView({ text, issues, catalog, onChange }: TextViewProps): Re
     });
   }, [text]);
 
+  // The engine's answer comes after the text changed: shown when it arrives.
   useEffect(() => {
-    if (view.current) forceLinting(view.current);
+    const v = view.current;
+    if (v) v.dispatch(setDiagnostics(v.state, lintOf(v.state, issues)));
   }, [issues]);
 
   const goTo = (line: number, col: number): void => {

@@ -1,13 +1,12 @@
 /**
  * The editor's state: the pipeline's text (the source of truth), its undo/redo history of text
- * snapshots, the blocks read from it (the last ones that parsed while the text does not) and the
- * problems found in it. Canvas and inspector edits go through the document model (`edit`); the
+ * snapshots and the blocks read from it (the last ones that parsed while the text does not); its
+ * problems are the engine's (use-validation.ts). Canvas and inspector edits go through the document model (`edit`); the
  * text view replaces the text (`setText`); both end as a new text snapshot.
  */
 import { useCallback, useMemo, useRef, useState } from "react";
-import type { CatalogInfo } from "../../engine/protocol";
 import { parseDocumentText, type EditableDocument } from "./doc";
-import { checkBlocks, readBlocks, type EditBlock, type EditIssue } from "./model";
+import { readBlocks, type EditBlock } from "./model";
 
 const MAX_HISTORY = 200;
 /** Typing in the text view within this time is one undo step. */
@@ -24,8 +23,6 @@ export interface EditorModel {
   text: string;
   file: string;
   blocks: EditBlock[];
-  /** YAML errors, then the blocks' problems. */
-  issues: EditIssue[];
   /** True when the text does not parse (the canvas shows the last blocks that did). */
   broken: boolean;
   canUndo: boolean;
@@ -42,11 +39,7 @@ export interface EditorModel {
   textNow(): string;
 }
 
-export function useEditor(
-  initialText: string,
-  initialFile: string,
-  catalog: CatalogInfo | undefined,
-): EditorModel {
+export function useEditor(initialText: string, initialFile: string): EditorModel {
   const [h, setH] = useState<History>({
     text: initialText,
     file: initialFile,
@@ -136,10 +129,6 @@ export function useEditor(
   const broken = read.errors.length > 0;
   if (!broken) lastGood.current = read.blocks;
   const blocks = broken ? lastGood.current : read.blocks;
-  const issues = useMemo(
-    () => (broken ? read.errors : checkBlocks(read.blocks, catalog)),
-    [broken, read, catalog],
-  );
 
   const freshName = useCallback((base: string): string => {
     try {
@@ -156,7 +145,6 @@ export function useEditor(
     text: h.text,
     file: h.file,
     blocks,
-    issues,
     broken,
     canUndo: h.past.length > 0,
     canRedo: h.future.length > 0,
