@@ -123,5 +123,5 @@ describe.skipIf(!haveChromium)("editor diagnostics, end to end (Chromium)", () =
     await page.screenshot({ path: artifact("editor-diagnostics.png") });
     expect(app.errors).toEqual([]);
     await app.close();
-  });
+  }, 90_000);
 });
