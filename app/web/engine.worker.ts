@@ -7,10 +7,11 @@
 /// <reference lib="webworker" />
 import { catalog } from "../blocks/catalog";
 import { sessionRecordingFormats } from "../blocks/recording/session-formats";
-import type { Resources } from "../engine/block";
+import type { FileWriteHandle, Resources } from "../engine/block";
 import { MonotonicClock } from "../engine/clock";
 import { initDsp } from "../engine/dsp";
 import type { EngineMessage } from "../engine/protocol";
+import { MemoryFile } from "../engine/recording/memory-file";
 import { CoarseLoop } from "../engine/runtime/coarse-loop";
 import { RealtimeLoop } from "../engine/runtime/loop";
 import { EngineSession, type LoopHooks, type SessionPlatform } from "../engine/session";
@@ -32,6 +33,40 @@ const yieldNow = (fn: () => void): void => {
   channel.port2.postMessage(0);
 };
 
+/** The last part of a path: the name a download gets. */
+const fileName = (p: string, fallback: string): string => p.split(/[/\\]/).pop() || fallback;
+
+/**
+ * A file a block writes (an XdfRecorder's, an EdfRecorder's), kept in memory and handed to the
+ * page as a download when the block closes it (at stop, or when its recording is switched off).
+ */
+function downloadOnClose(p: string): FileWriteHandle {
+  const file = new MemoryFile(p);
+  let sent = false;
+  return {
+    path: p,
+    get size() {
+      return file.size;
+    },
+    write: (b) => file.write(b),
+    writeAt: (b, at) => file.writeAt(b, at),
+    sync: () => {},
+    close() {
+      file.close();
+      if (sent) return;
+      sent = true;
+      const bytes = file.bytes;
+      const msg: EngineMessage = {
+        type: "download",
+        name: fileName(p, "recording"),
+        mime: "application/octet-stream",
+        bytes,
+      };
+      self.postMessage(msg, [bytes.buffer]);
+    },
+  };
+}
+
 /** Files are fetched relative to the pipeline file's URL (pipelines and their data are static). */
 function fetchResources(file: string): Resources {
   const base = new URL(file, self.location.href);
@@ -44,9 +79,13 @@ function fetchResources(file: string): Resources {
       if (!r.ok) throw new Error(`cannot read ${url}: HTTP ${r.status}`);
       return r.text();
     },
+    // No files here: a recorder block's file is kept in memory and downloaded when it closes.
+    openWrite(p: string) {
+      return downloadOnClose(p);
+    },
     // No files here: the page downloads what a block saves (a Buffer's rows, a model).
     writeText(p: string, text: string) {
-      const name = p.split(/[/\\]/).pop() || "mosaic.txt";
+      const name = fileName(p, "mosaic.txt");
       const bytes = new TextEncoder().encode(text);
       const msg: EngineMessage = { type: "download", name, mime: "text/plain", bytes };
       self.postMessage(msg, [bytes.buffer]);

@@ -116,6 +116,41 @@ describe.skipIf(!haveChromium)("Record button (browser build, Chromium)", () => 
     await app.close();
   });
 
+  test("an XdfRecorder block in the browser build: its file is downloaded when it closes", async () => {
+    const app = await openApp(chromium, served.url, "e2e/record-block.yaml");
+    const { page } = app;
+    const node = '.block-node[data-block="Recorder"]';
+    // It records (in memory): its status counts the samples written.
+    await page.waitForFunction(
+      (sel) => {
+        const text =
+          (globalThis as unknown as InPage).document.querySelector(sel)?.textContent ?? "";
+        const m = /recording rec-block\.xdf: .* ([\d,]+) samples/.exec(text);
+        return m !== null && Number(m[1]!.replaceAll(",", "")) >= 100;
+      },
+      node,
+      { timeout: 20_000, polling: 100 },
+    );
+    const [download, reply] = await Promise.all([
+      page.waitForEvent("download"),
+      page.evaluate(() =>
+        (globalThis as unknown as InPage).mosaic.client.invoke("Recorder", "stop"),
+      ),
+    ]);
+    expect(reply).toMatchObject({ ok: true });
+    expect(download.suggestedFilename()).toBe("rec-block.xdf");
+    const xdf = readXdf(bytesSource(new Uint8Array(readFileSync((await download.path())!))));
+    expect(xdf.problem).toBe("");
+    const [emg] = xdf.streams;
+    expect(emg!.header.name).toBe("Emg");
+    expect(emg!.header.channelCount).toBe(4);
+    expect(emg!.footer).toBeDefined();
+    expect(emg!.t.length).toBeGreaterThanOrEqual(100);
+    for (let i = 1; i < emg!.t.length; i++) expect(emg!.t[i]!).toBeGreaterThan(emg!.t[i - 1]!);
+    expect(app.errors).toEqual([]);
+    await app.close();
+  });
+
   test("Save model in the browser build downloads the model file instead of failing", async () => {
     const app = await openApp(chromium, served.url, "e2e/save-model.yaml");
     const { page } = app;

@@ -371,7 +371,7 @@ Rec: { Type: EdfRecorder, Inputs: [Arm, Sin], Params: { File: named, RecordDurat
     );
     h.start();
     h.push(vectors([1], [[1]]), 0);
-    expect(h.text).toBe("this runtime cannot write files (browser build): nothing is recorded");
+    expect(h.text).toBe("no file access in this runtime: nothing is recorded");
   });
 
   test("load errors name the param and say what is wrong", async () => {

@@ -119,8 +119,9 @@ export const EdfRecorder = defineBlock({
     "with the first record (its start time is the earliest first sample). An input that falls " +
     "about 2 s behind another has its last value held to keep the file going, and as many of its " +
     "late samples are dropped: both counted. `stop` (or Recording: false) finishes the file " +
-    "(samples of an incomplete last record are not written); `start` begins a new one. Where the " +
-    "runtime cannot write files (the browser build) it records nothing and says so.",
+    "(samples of an incomplete last record are not written); `start` begins a new one. In the " +
+    "browser build the file is kept in memory and downloaded when it is finished; where a " +
+    "runtime has no file access at all it records nothing and says so.",
   params: edfParams,
   inputs: { min: 1, max: Infinity },
   outputs: [],
@@ -141,7 +142,7 @@ export const EdfRecorder = defineBlock({
 
     const describe = () => {
       if (!ctx.resources.openWrite) {
-        ctx.setText("this runtime cannot write files (browser build): nothing is recorded");
+        ctx.setText("no file access in this runtime: nothing is recorded");
       } else if (session) ctx.setText(describeSession(session, setup.duration.us, false));
       else if (last) ctx.setText(describeSession(last, setup.duration.us, true));
       else ctx.setText(recording ? "waiting for the pipeline to start" : "stopped");

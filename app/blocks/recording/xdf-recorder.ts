@@ -72,7 +72,8 @@ export const XdfRecorder = defineBlock({
     "the operating system at once, so a killed process loses at most the last ~0.1 s and the file " +
     "opens without its footers; `mosaic repair FILE.xdf` adds them. The file opens when the " +
     "pipeline starts (or with `start`), `stop` or `Recording: false` closes it, and `start` " +
-    "opens a new one. Where the runtime cannot write files (the browser build) it records " +
+    "opens a new one. In the browser build the file is kept in memory and downloaded when it " +
+    "closes (at stop, or with `stop`); where a runtime has no file access at all it records " +
     "nothing and says so in its status.",
   params,
   inputs: { min: 1, max: Infinity },
@@ -188,8 +189,7 @@ class Recorder {
     if (this.writer !== null) return;
     const res = this.ctx.resources;
     if (res.openWrite === undefined) {
-      this.failure =
-        "no file access in this runtime (browser build): nothing is recorded (downloading a recording is not supported yet)";
+      this.failure = "no file access in this runtime: nothing is recorded";
       this.describe();
       return;
     }
