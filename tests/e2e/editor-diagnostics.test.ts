@@ -84,8 +84,11 @@ describe.skipIf(!haveChromium)("editor diagnostics, end to end (Chromium)", () =
     const app = await openApp(chromium, served.url);
     const { page } = app;
     await page.click('button:has-text("Edit")');
-    await page.waitForSelector('.text-view [aria-label="Pipeline YAML"]');
-    await page.fill('.text-view [aria-label="Pipeline YAML"]', broken);
+    // Typed over the whole text: CodeMirror's select-all (a DOM selection may cover only the
+    // lines it has drawn so far), then the text as one input.
+    await page.click('.text-view [aria-label="Pipeline YAML"]');
+    await page.keyboard.press("Control+a");
+    await page.keyboard.insertText(broken);
 
     // Every message the CLI prints, shown together (whatever order they arrive in); on a
     // timeout the comparison below says what was shown instead.
