@@ -16,7 +16,7 @@ import { EngineSession } from "../../app/engine/session";
 import { nodeResources } from "../../app/host/resources";
 import { loadDspFromDisk, validatePipelineFile } from "../../app/host/validate";
 import type { Reply } from "../../app/ui/client/engine-client";
-import { issuesFromReply } from "../../app/ui/editor/use-validation";
+import { issuesFromReply } from "../../app/ui/editor/validation-issues";
 
 const TIMER = "Timer: { Type: ScheduledTimer, DesiredRate: 200 }\n";
 

@@ -5,10 +5,11 @@
  * once and positioned. While a newer text is being checked the last answer stays on screen.
  */
 import { useEffect, useRef, useState } from "react";
-import type { Diagnostic } from "../../engine/diagnostics";
-import { diagnosticText } from "../../engine/protocol-diagnostics";
-import type { EngineClient, Reply } from "../client/engine-client";
+import type { EngineClient } from "../client/engine-client";
 import type { EditIssue } from "./model";
+import { issuesFromReply } from "./validation-issues";
+
+export { issueFromDiagnostic, issuesFromReply } from "./validation-issues";
 
 /** Typing pauses this long before the text is checked. */
 const PAUSE_MS = 250;
@@ -18,33 +19,6 @@ export interface Validation {
   issues: EditIssue[];
   /** The text on screen is newer than the one `issues` are about. */
   checking: boolean;
-}
-
-/** A diagnostic as the editor lists it: the CLI's text, at its line and column. */
-export function issueFromDiagnostic(d: Diagnostic): EditIssue {
-  return {
-    severity: d.severity === "error" ? "error" : "warning",
-    message: diagnosticText(d),
-    ...(d.block !== undefined ? { block: d.block } : {}),
-    line: d.line,
-    col: d.col,
-  };
-}
-
-/** The problems in a `validate` reply (notes on what a stage did are not problems). */
-export function issuesFromReply(r: Reply): EditIssue[] {
-  if (!r.ok) {
-    const why = r.message ?? "no reason given";
-    return [
-      {
-        severity: "error",
-        message: `the engine could not check the text: ${why}`,
-        line: 0,
-        col: 0,
-      },
-    ];
-  }
-  return (r.diagnostics ?? []).filter((d) => d.severity !== "info").map(issueFromDiagnostic);
 }
 
 interface Checked {
