@@ -6,7 +6,7 @@
 import { z } from "zod";
 import { outputNames } from "./block";
 import { catalogTypes, type Catalog } from "./catalog";
-import type { Clock } from "./clock";
+import { VirtualClock, type Clock } from "./clock";
 import { errorMessage, type Diagnostic } from "./diagnostics";
 import type { Frame } from "./frame";
 import { loadPipeline, type LoadResult, type PipelineSpec } from "./pipeline/loader";
@@ -404,17 +404,17 @@ export class EngineSession {
     source: string,
     simulateDevices = false,
   ): Promise<{ diagnostics: Diagnostic[]; graph?: GraphInfo }> {
-    this.unload();
-    this.file = file;
-    this.simulated = simulateDevices;
     const parsed = this.platform.loadPipeline
       ? await this.platform.loadPipeline(source, file)
       : loadPipeline(source, file, this.catalog);
     const loaded = withSimulatedDevices(parsed, this.catalog, simulateDevices ? {} : undefined);
-    if (!loaded.spec) {
-      this.setState("empty");
-      return { diagnostics: loaded.diagnostics };
-    }
+    // A text that does not load leaves what runs running (issue 17, defect 4).
+    if (!loaded.spec) return this.rejected(loaded.diagnostics);
+    const rejected = await this.precheck(loaded.spec, file);
+    if (rejected.length > 0) return this.rejected([...loaded.diagnostics, ...rejected]);
+    this.unload();
+    this.file = file;
+    this.simulated = simulateDevices;
     const logs = this.platform.logs?.(file);
     const created = await Runtime.create({
       spec: loaded.spec,
@@ -435,6 +435,30 @@ export class EngineSession {
     this.spec = loaded.spec;
     this.setState("loaded");
     return { diagnostics, graph: this.graph() };
+  }
+
+  /** A load that failed: what runs stays (nothing loaded: the state says "empty"). */
+  private rejected(diagnostics: Diagnostic[]): { diagnostics: Diagnostic[] } {
+    if (!this.rt) this.setState("empty");
+    return { diagnostics };
+  }
+
+  /**
+   * While a pipeline is loaded, the blocks of its replacement are first instantiated on a
+   * virtual clock (as `validate` does) so that one that cannot be created does not stop it.
+   */
+  private async precheck(spec: PipelineSpec, file: string): Promise<Diagnostic[]> {
+    if (!this.rt) return [];
+    const created = await Runtime.create({
+      spec,
+      catalog: this.catalog,
+      clock: new VirtualClock(0),
+      virtual: true,
+      resources: this.platform.resources(file),
+      ignorePlacement: true,
+    });
+    created.runtime?.dispose();
+    return created.diagnostics.filter((d) => d.severity === "error");
   }
 
   /** The catalog's metadata for the editor (built once: the catalog never changes). */

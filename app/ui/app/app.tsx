@@ -294,6 +294,12 @@ function Shell({
     window.history.replaceState(null, "", url);
   };
 
+  // The window's title names what the engine has (the header's picker does too).
+  useEffect(() => {
+    const name = pipeline.file !== undefined && graph !== undefined ? shortName(pipeline.file) : "";
+    document.title = name ? `${name} — MOSAIC` : "MOSAIC — live pipeline";
+  }, [pipeline.file, graph]);
+
   const onOpenFile = async (e: React.ChangeEvent<HTMLInputElement>): Promise<void> => {
     const f = e.target.files?.[0];
     e.target.value = "";
@@ -486,6 +492,27 @@ function Shell({
                 aria-label="Dismiss the warnings"
                 onClick={() => setWarningsHidden(generation)}
               >
+          {!editing && graph !== undefined && pipeline.rejected ? (
+            <div className="warnings-banner rejected-banner" data-rejected={pipeline.rejected.file}>
+              <p>
+                <strong>{shortName(pipeline.rejected.file)}</strong> was not loaded:{" "}
+                <strong>{shortName(pipeline.file ?? "")}</strong> goes on{" "}
+                {running ? "running" : "loaded"}.
+              </p>
+              <Diagnostics
+                diagnostics={pipeline.rejected.diagnostics}
+                error={pipeline.rejected.error}
+                failed
+              />
+              <button
+                type="button"
+                aria-label="Dismiss the problems of the file that was not loaded"
+                onClick={pipeline.dismissRejected}
+              >
+                ×
+              </button>
+            </div>
+          ) : null}
                 ×
               </button>
             </div>

@@ -1,37 +1,23 @@
 /**
  * Loading pipelines: the list of examples (pipelines/index.json of the browser build), fetching a
  * file, sending `load` and, when it loads, `start`. Keeps the file's text for "Save layout" and
- * the diagnostics of a file that does not load.
+ * the diagnostics of a file that does not load. The engine keeps what runs when a file does not
+ * load: so does the page (named in the picker, the failure shown beside it; issue 17, defect 4).
  */
 import { useCallback, useEffect, useRef, useState } from "react";
-import type { Diagnostic } from "../../engine/diagnostics";
 import type { GraphInfo } from "../../engine/protocol";
 import type { EngineClient, Reply } from "../client/engine-client";
 import type { LoadReport } from "./log-book";
+import {
+  afterLoad,
+  keepsRunning,
+  loadError,
+  type PipelineEntry,
+  type PipelineState,
+  type Rejected,
+} from "./pipeline-state";
 
-export interface PipelineEntry {
-  file: string;
-  title: string;
-}
-
-export interface PipelineState {
-  /** Examples offered by the picker. */
-  index: PipelineEntry[];
-  /** What the picker shows. */
-  selected: string;
-  /** The file being loaded or loaded last. */
-  file: string | undefined;
-  source: string | undefined;
-  graph: GraphInfo | undefined;
-  /** Increases with every load (a key for components that start fresh per load). */
-  generation: number;
-  loading: boolean;
-  diagnostics: Diagnostic[];
-  /** A problem that is not in the file (network, engine). */
-  error: string | undefined;
-  /** Load with simulated devices (the toolbar's switch). */
-  simulateDevices: boolean;
-}
+export type { PipelineEntry, PipelineState, Rejected } from "./pipeline-state";
 
 export const DEFAULT_PIPELINE = "pipelines/demo.yaml";
 
@@ -51,8 +37,12 @@ export function usePipeline(client: EngineClient, initial: string, simulateDevic
     diagnostics: [],
     error: undefined,
     simulateDevices,
+    rejected: undefined,
   });
   const busy = useRef(0);
+  // The state as last rendered (a finished load builds on it: see afterLoad).
+  const current = useRef(s);
+  current.current = s;
   const reportListeners = useRef(new Set<(r: LoadReport) => void>());
   const report = useCallback((r: LoadReport) => {
     for (const l of reportListeners.current) l(r);
@@ -87,22 +77,15 @@ export function usePipeline(client: EngineClient, initial: string, simulateDevic
   const loadSource = useCallback(
     async (file: string, source: string, autostart = true): Promise<Reply> => {
       const ticket = ++busy.current;
-      setS((p) => ({ ...p, loading: true, file, error: undefined }));
+      setS((p) => ({ ...p, loading: true }));
       const r = await client.load(file, source, simulate.current);
       if (ticket !== busy.current) return { ok: false, message: "another load started" };
+      const kept = client.state !== "empty";
+      const replaced = !keepsRunning(current.current, r, kept);
       const diagnostics = r.diagnostics ?? [];
-      const error = r.ok || diagnostics.length > 0 ? undefined : (r.message ?? "cannot load");
-      report({ file, diagnostics, ...(error !== undefined ? { error } : {}), replaced: true });
-      setS((p) => ({
-        ...p,
-        loading: false,
-        file,
-        source,
-        graph: r.graph,
-        generation: p.generation + 1,
-        diagnostics,
-        error,
-      }));
+      const error = loadError(r);
+      report({ file, diagnostics, ...(error !== undefined ? { error } : {}), replaced });
+      setS((p) => afterLoad(p, file, source, r, kept));
       if (r.ok && autostart) await client.start();
       return r;
     },
@@ -121,13 +104,25 @@ export function usePipeline(client: EngineClient, initial: string, simulateDevic
       } catch (e) {
         const error = `Cannot read ${file}: ${(e as Error).message}`;
         report({ file, diagnostics: [], error, replaced: false });
-        setS((p) => ({ ...p, file, loading: false, error }));
+        setS((p) =>
+          p.graph !== undefined
+            ? {
+                ...p,
+                loading: false,
+                selected: p.file ?? p.selected,
+                rejected: rejectedRead(file, error),
+              }
+            : { ...p, file, loading: false, error },
+        );
         return { ok: false, message: `cannot read ${file}` };
       }
       return loadSource(file, text, autostart);
     },
     [loadSource, report],
   );
+
+  /** Hides the failed load shown beside the running pipeline. */
+  const dismissRejected = useCallback(() => setS((p) => ({ ...p, rejected: undefined })), []);
 
   const select = useCallback((file: string) => setS((p) => ({ ...p, selected: file })), []);
 
@@ -153,6 +148,7 @@ export function usePipeline(client: EngineClient, initial: string, simulateDevic
         generation: p.generation + 1,
         diagnostics: [],
         error: undefined,
+        rejected: undefined,
         simulateDevices: graph.simulateDevices === true,
       }));
     },
@@ -162,5 +158,18 @@ export function usePipeline(client: EngineClient, initial: string, simulateDevic
   // Another client of a shared engine (a tab, the desktop menu) loaded a pipeline: show it.
   useEffect(() => client.onRemoteGraph(adopt), [client, adopt]);
 
-  return { ...s, load, loadSource, select, adopt, setSimulateDevices, onLoadReport };
+  return {
+    ...s,
+    load,
+    loadSource,
+    select,
+    adopt,
+    setSimulateDevices,
+    onLoadReport,
+    dismissRejected,
+  };
+}
+
+function rejectedRead(file: string, error: string): Rejected {
+  return { file, diagnostics: [], error };
 }
