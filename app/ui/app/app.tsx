@@ -287,18 +287,18 @@ function Shell({
     });
   }, [pipeline, initialPipeline, sharedEngine, client]);
 
+  // The window's title names what the engine has (the header's picker does too).
+  useEffect(() => {
+    const name = pipeline.file !== undefined && graph !== undefined ? shortName(pipeline.file) : "";
+    document.title = name ? `${name} — MOSAIC` : "MOSAIC — live pipeline";
+  }, [pipeline.file, graph]);
+
   const selectPipeline = (file: string): void => {
     pipeline.select(file);
     const url = new URL(window.location.href);
     url.searchParams.set("pipeline", file);
     window.history.replaceState(null, "", url);
   };
-
-  // The window's title names what the engine has (the header's picker does too).
-  useEffect(() => {
-    const name = pipeline.file !== undefined && graph !== undefined ? shortName(pipeline.file) : "";
-    document.title = name ? `${name} — MOSAIC` : "MOSAIC — live pipeline";
-  }, [pipeline.file, graph]);
 
   const onOpenFile = async (e: React.ChangeEvent<HTMLInputElement>): Promise<void> => {
     const f = e.target.files?.[0];
@@ -481,17 +481,6 @@ function Shell({
               onClose={leaveEdit}
             />
           ) : null}
-          {!editing &&
-          graph !== undefined &&
-          pipeline.diagnostics.length > 0 &&
-          warningsHidden !== generation ? (
-            <div className="warnings-banner">
-              <Diagnostics diagnostics={pipeline.diagnostics} error={undefined} failed={false} />
-              <button
-                type="button"
-                aria-label="Dismiss the warnings"
-                onClick={() => setWarningsHidden(generation)}
-              >
           {!editing && graph !== undefined && pipeline.rejected ? (
             <div className="warnings-banner rejected-banner" data-rejected={pipeline.rejected.file}>
               <p>
@@ -513,6 +502,17 @@ function Shell({
               </button>
             </div>
           ) : null}
+          {!editing &&
+          graph !== undefined &&
+          pipeline.diagnostics.length > 0 &&
+          warningsHidden !== generation ? (
+            <div className="warnings-banner">
+              <Diagnostics diagnostics={pipeline.diagnostics} error={undefined} failed={false} />
+              <button
+                type="button"
+                aria-label="Dismiss the warnings"
+                onClick={() => setWarningsHidden(generation)}
+              >
                 ×
               </button>
             </div>
