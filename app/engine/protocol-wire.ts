@@ -5,6 +5,13 @@
  * ±Infinity) as `{"$n": "NaN"}` instead of becoming `null`.
  */
 
+/**
+ * WebSocket close codes `mosaic serve` refuses a socket with, before any message (the reason
+ * says why in words): a wrong or missing token, a page from another origin.
+ */
+export const CLOSE_BAD_TOKEN = 4401;
+export const CLOSE_FOREIGN_ORIGIN = 4403;
+
 const B64 = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
 const LOOKUP = new Int16Array(128).fill(-1);
 for (let i = 0; i < B64.length; i++) LOOKUP[B64.charCodeAt(i)] = i;

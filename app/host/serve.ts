@@ -2,7 +2,10 @@
  * `mosaic serve`: the UI (the browser build's files) over HTTP and the engine over a WebSocket,
  * the engine running here in a worker thread with the native bridges (UDP, serial, …). Binds
  * 127.0.0.1 by default. The WebSocket needs the session's random token (in the printed URL) and
- * a same-origin page: another site open in the same browser cannot drive the devices. Several
+ * a same-origin page: another site open in the same browser cannot drive the devices. A socket
+ * without them is opened and closed at once, before any message, with close code 4401 (token) or
+ * 4403 (origin) and the reason in words, so the page can say why it got no engine (a browser
+ * hides an HTTP refusal's status from the page). Several
  * tabs may watch and control the same engine; closing one changes nothing for the others.
  *
  * Pipelines loaded over the socket read and write only inside the allowed folders (the examples'
@@ -20,7 +23,12 @@ import type { IncomingMessage } from "node:http";
 import type { Duplex } from "node:stream";
 import { WebSocketServer, type WebSocket } from "ws";
 import { errorMessage } from "../engine/diagnostics";
-import { decodeWire, encodeWire } from "../engine/protocol-wire";
+import {
+  CLOSE_BAD_TOKEN,
+  CLOSE_FOREIGN_ORIGIN,
+  decodeWire,
+  encodeWire,
+} from "../engine/protocol-wire";
 import { defaultAllowedDirs, SessionHub, type SessionHubOptions } from "./session-hub";
 import { serveStatic, type WebServer } from "./web-server";
 
@@ -110,6 +118,16 @@ export async function serve(o: ServeOptions): Promise<Served> {
   const refuse = (socket: Duplex, code: number, why: string): void => {
     socket.end(`HTTP/1.1 ${code} ${why}\r\nConnection: close\r\nContent-Length: 0\r\n\r\n`);
   };
+  /** Opens the socket only to close it with `code` and `why`: the page learns the cause. */
+  const turnAway = (
+    req: IncomingMessage,
+    socket: Duplex,
+    head: Buffer,
+    code: number,
+    why: string,
+  ): void => {
+    wss.handleUpgrade(req, socket, head, (ws) => ws.close(code, why));
+  };
 
   web.server.on("upgrade", (req: IncomingMessage, socket: Duplex, head: Buffer) => {
     let url: URL;
@@ -124,7 +142,7 @@ export async function serve(o: ServeOptions): Promise<Served> {
       return;
     }
     if (!sameToken(url.searchParams.get("token") ?? "", token)) {
-      refuse(socket, 401, "Unauthorized");
+      turnAway(req, socket, head, CLOSE_BAD_TOKEN, "wrong or missing token");
       return;
     }
     // Browsers always send Origin on WebSocket requests: only our own page may connect.
@@ -134,7 +152,9 @@ export async function serve(o: ServeOptions): Promise<Served> {
       from !== origin &&
       from !== origin.replace("127.0.0.1", "localhost")
     ) {
-      refuse(socket, 403, "Forbidden");
+      // A close reason holds 123 bytes: the foreign origin, printable ASCII, is cut short.
+      const shown = from.replace(/[^\x20-\x7e]/g, "?").slice(0, 48);
+      turnAway(req, socket, head, CLOSE_FOREIGN_ORIGIN, `a page from ${shown} (not ${origin})`);
       return;
     }
     wss.handleUpgrade(req, socket, head, (ws) => attach(ws));

@@ -75,11 +75,11 @@ describe.skipIf(!haveChromium)("mosaic serve in Chromium", () => {
     await b.close();
   }, 60_000);
 
-  test("a wrong token gets no engine: the page says the connection closed", async () => {
+  test("a wrong token gets no engine: the page says mosaic serve refused it", async () => {
     const bad = url.replace(/token=[^&]+/, "token=wrong");
     const p = await openApp(browser, bad, undefined, { waitRunning: false });
     await p.page.waitForFunction(
-      `/connection to the MOSAIC host closed/.test(document.body.textContent || "")`,
+      `/mosaic serve refused this page/.test(document.body.textContent || "")`,
       undefined,
       {
         timeout: 10_000,

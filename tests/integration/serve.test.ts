@@ -7,7 +7,12 @@ import type { ChildProcess } from "node:child_process";
 import { afterAll, beforeAll, describe, expect, test } from "vitest";
 import WebSocket from "ws";
 import type { EngineMessage } from "../../app/engine/protocol";
-import { decodeWire, encodeWire } from "../../app/engine/protocol-wire";
+import {
+  CLOSE_BAD_TOKEN,
+  CLOSE_FOREIGN_ORIGIN,
+  decodeWire,
+  encodeWire,
+} from "../../app/engine/protocol-wire";
 import { requireBuild, startCli } from "./helpers";
 
 let cli: ChildProcess;
@@ -54,6 +59,15 @@ function open(target: string, origin = url.origin): Promise<WebSocket | number> 
   });
 }
 
+/** Opens a socket the host turns away: resolves with the close code and reason it sent. */
+function refusal(target: string, origin = url.origin): Promise<{ code: number; reason: string }> {
+  return new Promise((resolve) => {
+    const ws = new WebSocket(target, { origin });
+    ws.once("close", (code, reason) => resolve({ code, reason: String(reason) }));
+    ws.once("error", () => resolve({ code: -1, reason: "" }));
+  });
+}
+
 function collect(ws: WebSocket): EngineMessage[] {
   const got: EngineMessage[] = [];
   ws.on("message", (d) => got.push(decodeWire(String(d)) as EngineMessage));
@@ -80,11 +94,19 @@ describe("mosaic serve", () => {
     expect(await r.text()).toMatch(/<div id="root">/);
   });
 
-  test("the WebSocket refuses a missing or wrong token and a foreign origin", async () => {
+  test("the WebSocket refuses a missing or wrong token and a foreign origin, saying why", async () => {
     const token = url.searchParams.get("token")!;
-    expect(await open(wsUrl(null))).toBe(401);
-    expect(await open(wsUrl("x" + token.slice(1)))).toBe(401);
-    expect(await open(wsUrl(token), "http://evil.example")).toBe(403);
+    const badToken = { code: CLOSE_BAD_TOKEN, reason: "wrong or missing token" };
+    expect(await refusal(wsUrl(null))).toEqual(badToken);
+    expect(await refusal(wsUrl("x" + token.slice(1)))).toEqual(badToken);
+    expect(await refusal(wsUrl(token), "http://evil.example")).toEqual({
+      code: CLOSE_FOREIGN_ORIGIN,
+      reason: `a page from http://evil.example (not ${url.origin})`,
+    });
+    // A long foreign origin still gets a close with its reason (at most 123 bytes).
+    const long = await refusal(wsUrl(token), `http://${"e".repeat(300)}.example`);
+    expect(long.code).toBe(CLOSE_FOREIGN_ORIGIN);
+    expect(Buffer.byteLength(long.reason)).toBeLessThanOrEqual(123);
   });
 
   test("clients share the running demo; the engine survives a closed client", async () => {

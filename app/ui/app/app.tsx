@@ -7,11 +7,13 @@
 import { useCallback, useEffect, useMemo, useRef, useState } from "react";
 import type { EngineState } from "../../engine/protocol";
 import type { EngineClient } from "../client/engine-client";
+import type { EngineWhere } from "../client/connection-status";
 import { EngineContext, useEngine, useEngineInfo, useEngineState } from "../client/hooks";
 import { BlockTable } from "../graph/block-table";
 import { StimulusOverlay } from "../stimulus/stimulus-view";
 import { Editor, EMPTY_FILE } from "../editor/editor";
 import { Diagnostics } from "./diagnostics";
+import { ConnectionLost, EngineBadge, useConnectionLoss, type LossSource } from "./engine-badge";
 import { EventLog } from "./event-log";
 import { GestureLegend, useGestureKeys } from "./gestures";
 import { setBlockParam } from "../graph/layout-yaml";
@@ -100,9 +102,13 @@ function PipelinePicker({
 function Shell({
   initialPipeline,
   sharedEngine,
+  engine,
+  connection,
 }: {
   initialPipeline: string;
   sharedEngine: boolean;
+  engine: EngineWhere;
+  connection: LossSource | undefined;
 }) {
   const client = useEngine();
   // The browser build has no devices at all: it simulates them unless told otherwise.
@@ -110,6 +116,7 @@ function Shell({
   const { graph, generation } = pipeline;
   const state = useEngineState();
   const info = useEngineInfo();
+  const loss = useConnectionLoss(connection);
   const reducedMotion = useReducedMotion();
   const running = state === "running";
 
@@ -451,13 +458,16 @@ function Shell({
             Simulate devices
           </label>
           <span className="toolbar__spacer" />
+          <EngineBadge where={engine} />
           <span
             className={`timing ${info.sharedMemory ? "is-precise" : "is-coarse"}`}
             data-shared-memory={String(info.sharedMemory)}
             title={info.engine}
           >
             {!info.connected
-              ? "engine starting…"
+              ? loss
+                ? "not connected"
+                : "engine starting…"
               : info.sharedMemory
                 ? "precise timing (shared memory)"
                 : "coarse timing (no shared memory)"}
@@ -465,6 +475,7 @@ function Shell({
         </header>
 
         <main className="main">
+          {loss ? <ConnectionLost loss={loss} /> : null}
           {editing ? (
             <Editor
               client={client}
@@ -560,7 +571,7 @@ function Shell({
             </PanelHost>
           ) : failed ? (
             <Diagnostics diagnostics={pipeline.diagnostics} error={pipeline.error} failed />
-          ) : (
+          ) : loss ? null : (
             <p className="main__empty">
               {pipeline.loading ? "Loading the pipeline…" : "No pipeline loaded."}
             </p>
@@ -596,15 +607,26 @@ export function App({
   client,
   initialPipeline,
   sharedEngine = false,
+  engine = { kind: "page" },
+  connection,
 }: {
   client: EngineClient;
   initialPipeline: string;
   /** The engine is shared (a Node host or the desktop app): adopt what it already runs. */
   sharedEngine?: boolean;
+  /** Where the engine runs (named in the toolbar). */
+  engine?: EngineWhere;
+  /** The connection to `mosaic serve`, whose refusal or loss the page explains. */
+  connection?: LossSource;
 }) {
   return (
     <EngineContext.Provider value={client}>
-      <Shell initialPipeline={initialPipeline} sharedEngine={sharedEngine} />
+      <Shell
+        initialPipeline={initialPipeline}
+        sharedEngine={sharedEngine}
+        engine={engine}
+        connection={connection}
+      />
     </EngineContext.Provider>
   );
 }

@@ -2,10 +2,12 @@
  * The UI protocol over a WebSocket to a Node host (`mosaic serve`): the page's URL carries the
  * session token, the socket is `ws(s)://<same host>/ws?token=…`. Messages are JSON with typed
  * arrays and non-finite numbers kept (app/engine/protocol-wire.ts). Messages sent before the
- * socket opens are queued; when it closes the UI is told with an error event.
+ * socket opens are queued; when it closes the UI is told with an error event and `onLost` with its
+ * cause in words (a refusal by the host — wrong token, foreign page — names why: connection-status.ts).
  */
 import type { EngineConnection, EngineMessage, UiMessage } from "../../engine/protocol";
 import { decodeWire, encodeWire } from "../../engine/protocol-wire";
+import { explainClose, type ConnectionLoss } from "./connection-status";
 
 /** The minimal WebSocket surface used (the browser's, or `ws` in tests). */
 export interface SocketLike {
@@ -30,15 +32,27 @@ export function hostSocketUrl(page: { href: string }): string | null {
   return ws.href;
 }
 
-export function wsConnection(socket: SocketLike): EngineConnection {
+/** A connection to `mosaic serve` that also tells why it ended. */
+export interface HostConnection extends EngineConnection {
+  /** Why the socket closed (undefined while it is open or opening). */
+  readonly lost: ConnectionLoss | undefined;
+  /** Called once when the socket closes, with its cause; returns the unsubscribe. */
+  onLost(h: (loss: ConnectionLoss) => void): () => void;
+}
+
+export function wsConnection(socket: SocketLike): HostConnection {
   const handlers = new Set<(m: EngineMessage) => void>();
+  const lostHandlers = new Set<(loss: ConnectionLoss) => void>();
   const queue: string[] = [];
   let open = socket.readyState === 1;
+  let opened = open;
+  let lost: ConnectionLoss | undefined;
   const emit = (m: EngineMessage): void => {
     for (const h of handlers) h(m);
   };
   socket.onopen = () => {
     open = true;
+    opened = true;
     for (const q of queue.splice(0)) socket.send(q);
   };
   socket.onmessage = (ev) => {
@@ -53,21 +67,22 @@ export function wsConnection(socket: SocketLike): EngineConnection {
   };
   socket.onclose = (ev) => {
     open = false;
+    lost = explainClose(ev.code, ev.reason, opened);
     emit({
       type: "event",
-      event: {
-        t: Date.now() / 1000,
-        level: "error",
-        block: "engine",
-        message:
-          ev.code === 1006 || ev.code === 1000
-            ? "the connection to the MOSAIC host closed (is `mosaic serve` still running?)"
-            : `the connection to the MOSAIC host closed (${ev.code}${ev.reason ? `: ${ev.reason}` : ""})`,
-      },
+      event: { t: Date.now() / 1000, level: "error", block: "engine", message: lost.message },
     });
+    for (const h of lostHandlers) h(lost);
   };
   socket.onerror = () => {};
   return {
+    get lost() {
+      return lost;
+    },
+    onLost(h) {
+      lostHandlers.add(h);
+      return () => lostHandlers.delete(h);
+    },
     send(msg: UiMessage) {
       const text = encodeWire(msg);
       if (open) socket.send(text);
@@ -79,6 +94,7 @@ export function wsConnection(socket: SocketLike): EngineConnection {
     },
     close() {
       handlers.clear();
+      lostHandlers.clear();
       socket.close();
     },
   };
