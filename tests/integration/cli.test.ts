@@ -105,7 +105,15 @@ describe("mosaic run", () => {
     const child = startCli(["run", f, "--json"]);
     let out = "";
     child.stdout!.on("data", (d: Buffer) => (out += d.toString()));
-    await new Promise((r) => setTimeout(r, 2500));
+    // Interrupt once it has run for a while (its telemetry says so): a loaded machine may take
+    // seconds to start it, so no fixed wait.
+    const ranEnough = (): boolean =>
+      /"name":"Sine"[^}]*"events":(\d+)/
+        .exec(out.slice(out.lastIndexOf('"type":"telemetry"')))
+        ?.slice(1)
+        .some((n) => Number(n) > 600) ?? false;
+    const t0 = Date.now();
+    while (!ranEnough() && Date.now() - t0 < 30_000) await new Promise((r) => setTimeout(r, 50));
     child.kill("SIGINT");
     const code = await new Promise<number | null>((r) => child.on("exit", r));
     expect(code).toBe(0);
