@@ -19,6 +19,9 @@ import { requireBuild, ROOT } from "../integration/helpers";
 const TYPES = [
   "hello",
   "load",
+  "validate",
+  "record-start",
+  "record-stop",
   "start",
   "stop",
   "catalog",
