@@ -55,3 +55,17 @@ export function jsonLines(stdout: string): Record<string, unknown>[] {
  * (or the virtual clock) are where strict "ontime" belongs.
  */
 export const KEEPING_UP: readonly string[] = ["ontime", "stumbling"];
+
+/** The wall clock in UNIX seconds (what a real-time block harness's clock follows). */
+export const wall = (): number => (performance.timeOrigin + performance.now()) / 1000;
+
+export const sleep = (ms: number): Promise<void> => new Promise((r) => setTimeout(r, ms));
+
+/** Waits until `ok()` holds, polling every 5 ms; throws naming `what` after `ms`. */
+export async function until(ok: () => boolean, what: string, ms = 5000): Promise<void> {
+  const t0 = Date.now();
+  while (!ok()) {
+    if (Date.now() - t0 > ms) throw new Error(`timed out waiting for ${what}`);
+    await sleep(5);
+  }
+}

@@ -25,23 +25,22 @@ import {
 import { EMPTY_SHAPE, Frame } from "../../app/engine";
 import { BlockHarness } from "../../app/engine/testing";
 import { nodeTcpBridge } from "../../native-bridges/tcp";
-import { jsonLines, requireBuild, ROOT, runCli, startCli, tempDir } from "./helpers";
+import {
+  jsonLines,
+  requireBuild,
+  ROOT,
+  runCli,
+  startCli,
+  tempDir,
+  sleep,
+  wall,
+  until,
+} from "./helpers";
 
 const cleanup: (() => void | Promise<void>)[] = [];
 afterEach(async () => {
   for (const c of cleanup.splice(0).reverse()) await c();
 });
-
-const wall = (): number => (performance.timeOrigin + performance.now()) / 1000;
-const sleep = (ms: number) => new Promise((r) => setTimeout(r, ms));
-
-async function until(ok: () => boolean, what: string, ms = 5000): Promise<void> {
-  const t0 = Date.now();
-  while (!ok()) {
-    if (Date.now() - t0 > ms) throw new Error(`timed out waiting for ${what}`);
-    await sleep(5);
-  }
-}
 
 async function syncStation(seed = 1): Promise<SyncStationSimulator> {
   const sim = await SyncStationSimulator.start({ port: 0, seed });

@@ -29,23 +29,25 @@ import {
 } from "../../app/devices/sessantaquattro-simulator";
 import { BlockHarness } from "../../app/engine/testing";
 import { nodeTcpBridge } from "../../native-bridges/tcp";
-import { jsonLines, requireBuild, ROOT, runCli, startCli, tempDir } from "./helpers";
+import {
+  jsonLines,
+  requireBuild,
+  ROOT,
+  runCli,
+  startCli,
+  tempDir,
+  sleep,
+  wall,
+  until as waitUntil,
+} from "./helpers";
+
+/** Waits longer than the shared default: these devices take longer to connect under load. */
+const until = (ok: () => boolean, what: string, ms = 8000) => waitUntil(ok, what, ms);
 
 const cleanup: (() => void | Promise<void>)[] = [];
 afterEach(async () => {
   for (const c of cleanup.splice(0).reverse()) await c();
 });
-
-const wall = (): number => (performance.timeOrigin + performance.now()) / 1000;
-const sleep = (ms: number) => new Promise((r) => setTimeout(r, ms));
-
-async function until(ok: () => boolean, what: string, ms = 8000): Promise<void> {
-  const t0 = Date.now();
-  while (!ok()) {
-    if (Date.now() - t0 > ms) throw new Error(`timed out waiting for ${what}`);
-    await sleep(5);
-  }
-}
 
 /** A loopback port nothing listens on now. */
 async function freePort(): Promise<number> {
