@@ -126,7 +126,11 @@ export async function serve(o: ServeOptions): Promise<Served> {
     code: number,
     why: string,
   ): void => {
-    wss.handleUpgrade(req, socket, head, (ws) => ws.close(code, why));
+    wss.handleUpgrade(req, socket, head, (ws) => {
+      ws.close(code, why);
+      // The close frame is out; a client that never answers it is not waited for (ws waits 30 s).
+      setTimeout(() => ws.terminate(), 1000).unref();
+    });
   };
 
   web.server.on("upgrade", (req: IncomingMessage, socket: Duplex, head: Buffer) => {

@@ -61,9 +61,16 @@ function open(target: string, origin = url.origin): Promise<WebSocket | number> 
 
 /** Opens a socket the host turns away: resolves with the close code and reason it sent. */
 function refusal(target: string, origin = url.origin): Promise<{ code: number; reason: string }> {
-  return new Promise((resolve) => {
+  return new Promise((resolve, reject) => {
     const ws = new WebSocket(target, { origin });
-    ws.once("close", (code, reason) => resolve({ code, reason: String(reason) }));
+    const t = setTimeout(() => {
+      ws.terminate();
+      reject(new Error(`no close within 10 s for ${target} from ${origin.slice(0, 40)}`));
+    }, 10_000);
+    ws.once("close", (code, reason) => {
+      clearTimeout(t);
+      resolve({ code, reason: String(reason) });
+    });
     ws.once("error", () => resolve({ code: -1, reason: "" }));
   });
 }
@@ -107,7 +114,7 @@ describe("mosaic serve", () => {
     const long = await refusal(wsUrl(token), `http://${"e".repeat(300)}.example`);
     expect(long.code).toBe(CLOSE_FOREIGN_ORIGIN);
     expect(Buffer.byteLength(long.reason)).toBeLessThanOrEqual(123);
-  });
+  }, 60_000);
 
   test("clients share the running demo; the engine survives a closed client", async () => {
     const token = url.searchParams.get("token")!;
