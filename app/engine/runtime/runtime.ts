@@ -503,9 +503,14 @@ export class Runtime {
     // Blocks on other workers are instantiated here only for planning (when no plan was given).
     const planning: Node[] = [];
     const planningByName = new Map<string, Node>();
+    // Blocks that could not be created. A block fed by one cannot know its input's shape either:
+    // its own error would only repeat the first one (and blame a feedback cycle), so it is not
+    // reported (issue 17, defect 5).
+    const failed = new Set<string>();
     for (const b of order) {
       const local = isLocal(b);
       if (!local && opts.plan) continue;
+      const afterFailure = b.inputs.some((inp) => failed.has(inp.block));
       const inputs: InputInfo[] = b.inputs.map((inp, index) => {
         const src = rt.byName.get(inp.block) ?? planningByName.get(inp.block);
         const ghost = ghosts.get(inp.block);
@@ -538,6 +543,8 @@ export class Runtime {
       try {
         node.instance = await b.def.create(ctx, b.params);
       } catch (e) {
+        failed.add(b.name);
+        if (afterFailure) continue;
         const param = e instanceof BlockConfigError ? e.param : undefined;
         const pos =
           param !== undefined ? (b.paramPos[param.split(/[.[]/)[0]!] ?? b.paramsPos) : b.pos;
