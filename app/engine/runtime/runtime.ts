@@ -900,8 +900,10 @@ export class Runtime {
     }
     const now = this.clock.now();
     node.status.compute(performance.now() - t0, now, f.n);
-    // A block without outputs (a sink, a device output) is timed by what it consumes.
+    // A block without outputs (a sink, a device output) is timed by what it consumes; one that
+    // emits on request (no desired rate) is not idle while it consumes.
     if (node.ports.length === 0) node.status.record(f, now);
+    else node.status.consumed(now);
   }
 
   private fireEntry = (e: TimerEntry, n: number): void => {

@@ -43,3 +43,23 @@ describe("status: a device that delivers packets", () => {
     expect(s.evaluate(now + 0.051).status).toBe("idle");
   });
 });
+
+describe("status: a block that emits on request (no desired rate)", () => {
+  // A Buffer recording rows (Stream: false) or a recorder: it consumes its inputs at 25 Hz and
+  // emits nothing until asked.
+  test("reads on time while it consumes, idle a second after its inputs stop", () => {
+    const s = new StatusTracker(0);
+    expect(s.evaluate(0).status).toBe("idle");
+    for (let k = 0; k < 50; k++) s.consumed(k / 25);
+    const last = 49 / 25;
+    expect(s.evaluate(last + 0.04).status).toBe("ontime");
+    expect(s.evaluate(last + 0.9).status).toBe("ontime");
+    expect(s.evaluate(last + 1.1).status).toBe("idle");
+  });
+
+  test("a block with a desired rate is still idle when it consumes without output", () => {
+    const s = new StatusTracker(25);
+    for (let k = 0; k < 50; k++) s.consumed(k / 25);
+    expect(s.evaluate(49 / 25 + 0.01).status).toBe("idle");
+  });
+});

@@ -3,7 +3,9 @@
  * - rate = (n − 1) / (t_last − t_first) over the last 100 outputs (event timestamps);
  * - idle (grey) when there was no output for 10 periods and at least 50 ms (a gap between a
  *   device's packets is not idleness), plus the batching interval (during which a batch is
- *   allowed to wait), or none at all;
+ *   allowed to wait), or none at all. A block without a desired rate emits on request (a Buffer
+ *   recording rows, a recorder): while its outputs are silent it is timed by what it consumes, so
+ *   it reads idle only when neither output nor input came for a second;
  * - lagging (red) when rate < 95 % of DesiredRate, or when an input batch reached the block
  *   late: its oldest event waited longer than max(2 periods, 50 ms) plus the batching interval
  *   (the engine is behind real time; lossless timers keep rates exact, so a rate alone would not
@@ -68,6 +70,8 @@ export class StatusTracker {
   /** Total output events. */
   events = 0;
   lastWall = -Infinity;
+  /** Clock time of the last input batch processed (see `consumed`). */
+  lastInputWall = -Infinity;
   lastOverrunWall = -Infinity;
   /** Until when a late batch keeps the block lagging (clock time). */
   lateUntil = -Infinity;
@@ -149,6 +153,15 @@ export class StatusTracker {
       this.lateUntil = Math.max(this.lateUntil, now + Math.max(d, LATE_HOLD_S));
   }
 
+  /**
+   * Records that the block processed an input batch at clock time `now`. A block without a
+   * desired rate (it emits on request: a Buffer that records, a recorder) is not idle while it
+   * consumes, even when it emits nothing.
+   */
+  consumed(now: number): void {
+    this.lastInputWall = now;
+  }
+
   /** Ticks the block's `CatchUp: skip` timer has skipped so far (see `missed`). */
   missedTicks = 0;
 
@@ -214,9 +227,11 @@ export class StatusTracker {
     const rate = this.rate();
     const d = this.desiredRate;
     const idleAfter = idleAfterS(d, this.batchS);
-    if (this.events === 0 || now - this.lastWall > idleAfter) {
+    const silent = this.events === 0 || now - this.lastWall > idleAfter;
+    const consuming = !(d > 0) && now - this.lastInputWall <= idleAfter;
+    if (silent) {
       return {
-        status: "idle",
+        status: consuming ? "ontime" : "idle",
         rate: this.events === 0 ? 0 : rate,
         lagging: false,
         stumbling: false,
