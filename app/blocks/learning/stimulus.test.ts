@@ -123,13 +123,37 @@ describe("Stimulus", () => {
     expect(run(h, "stop")).toBe("not running");
   });
 
+  test("progress: cue number, cue count and the next cue's label (at rest: the one about to start)", async () => {
+    const h = await stimulus({
+      Labels: { rest: [0, 0], fist: [1, 0], open: [0, 1] },
+      Tasks: ["open", "fist"],
+      Repetitions: 2,
+      ...{ Rest: 0.5, Rise: 0.3, Hold: 0.2, Capture: 0.5, Fall: 0.3 },
+      Autostart: true,
+    });
+    // Each cue lasts 1.8 s: rest 0–0.4, rise 0.5–0.7, hold 0.8–0.9, capture 1.0–1.4, fall 1.5–1.7.
+    h.push(ticks(...range(100, 107.4)));
+    const progress = h.output("progress");
+    expect(progress.t).toEqual(h.output("phase").t);
+    const at = (t: number): number[] => progress.v[progress.t.indexOf(t)]!;
+    expect(at(100)).toEqual([1, 4, 2]); // resting before cue 1 (open, label 2)
+    expect(at(100.6)).toEqual([1, 4, 1]); // rising to open: fist is next
+    expect(at(101.8)).toEqual([2, 4, 1]); // resting before cue 2, fist
+    expect(at(102)).toEqual([2, 4, 1]);
+    expect(at(102.4)).toEqual([2, 4, 2]); // rising to fist: open is next (repetition 2)
+    expect(at(105.5)).toEqual([4, 4, 1]); // resting before the last cue, fist
+    expect(at(106)).toEqual([4, 4, NaN]); // the last cue: nothing comes next
+    expect(progress.v.at(-1)).toEqual([4, 4, NaN]); // the end
+    expect(h.output("phase").v.at(-1)).toEqual([5]);
+  });
+
   test("one frame of many ticks gives what one tick per frame gives", async () => {
     const a = await stimulus({ ...ONE, Autostart: true });
     const b = await stimulus({ ...ONE, Autostart: true });
     const ts = range(100, 102.5);
     a.push(ticks(...ts));
     for (const t of ts) b.push(ticks(t));
-    for (const port of ["target", "phase", "trigger", "cue"]) {
+    for (const port of ["target", "phase", "trigger", "cue", "progress"]) {
       expect(b.output(port).t).toEqual(a.output(port).t);
       expect(b.output(port).v).toEqual(a.output(port).v);
     }

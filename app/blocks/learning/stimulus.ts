@@ -208,7 +208,7 @@ export const Stimulus = defineBlock({
     "rising (τ: seconds into the phase), t while holding and capturing, t·cos²(π/2·τ/Fall) while " +
     "falling; `phase` [1, 1] is 0 rest, 1 rise, 2 hold, 3 capture, 4 fall, 5 end (sent once, on " +
     "the first tick after the last fall, with zeros); `cue` [1, 1] is the 0-based index of the task's label (NaN at rest and at " +
-    "the end). `trigger` [1, T] follows the Buffer's trigger protocol for steady contractions " +
+    "the end). `progress` [1, 3] is the protocol's position for a participant screen: the 1-based number of the current cue (at rest: of the cue about to start), the number of cues, and the label index of the next cue to start (at rest: the one about to start; NaN after the last). `trigger` [1, T] follows the Buffer's trigger protocol for steady contractions " +
     "only: the task's target at the first tick of its capture phase and all NaN when the capture " +
     "ends; plug it into a Buffer or a predictor's training input. Tasks are names of `Labels` or " +
     "`{ Label, Target }`; labels are numbered in Labels order, then in order of appearance. " +
@@ -241,7 +241,7 @@ export const Stimulus = defineBlock({
   legacyForm:
     "[captureSeconds, task1, task2, …]: the capture duration, then one target vector a;b;c per task",
   inputs: { min: 1, max: 2, labels: ["timer", "skip"] },
-  outputs: ["target", "phase", "trigger", "cue"],
+  outputs: ["target", "phase", "trigger", "cue", "progress"],
   live: ["Rest", "Rise", "Hold", "Capture", "Fall"],
   views: ["stimulus", "scope", "label"],
   panel:
@@ -281,6 +281,7 @@ export const Stimulus = defineBlock({
     let cue = 0;
     let phase = REST;
     let phaseStart = 0;
+    const progressOut = ctx.output(vectorShape(3), "progress", { labels: ["cue", "cues", "next"] });
     let phaseEnd = 0;
     let capturing = false;
     let lastT = 0;
@@ -405,11 +406,20 @@ export const Stimulus = defineBlock({
       for (let e = 0; e < n; e++) {
         if (state !== "armed" && state !== "running") break;
         const t = f.t[e]!;
+    /** The `progress` values at `off`: cue number, cue count, label of the next cue to start. */
+    const writeProgress = (v: Float64Array, off: number): void => {
+      v[off] = Math.min(cue + 1, N);
+      v[off + 1] = N;
+      const next = phase === REST ? cue : cue + 1;
+      v[off + 2] = phase !== END && next < N ? order[next]! : NaN;
+    };
+
         lastT = t;
         if (state === "armed") {
           state = "running";
           cue = 0;
           phase = REST;
+      let pr: Frame | null = null;
           phaseStart = t;
           phaseEnd = t + dur[REST]!;
           capturing = false;
@@ -433,11 +443,14 @@ export const Stimulus = defineBlock({
         if (phase === REST || phase === END) {
           o.v.fill(0, off, off + T);
           cu!.v[k] = NaN;
+          pr = progressOut.frame(n - e);
         } else {
           const label = order[cue]!;
           const tg = targets[label]!;
           let gain = 1;
+        pr!.t[k] = t;
           if (phase === RISE || phase === FALL) {
+        writeProgress(pr!.v, k * 3);
             const x = (Math.PI / 2) * ((t - phaseStart) / dur[phase]!);
             const s = phase === RISE ? Math.sin(x) : Math.cos(x);
             gain = s * s;
@@ -467,9 +480,11 @@ export const Stimulus = defineBlock({
     describe(0);
 
     return {
+        pr!.n = k;
       start() {
         started = true;
         if (p.Autostart) begin();
+        progressOut.emit(pr!);
         else subscribe(false);
       },
       stop() {
