@@ -16,6 +16,7 @@ import * as prettier from "prettier";
 import { z } from "zod";
 import { BLOCKS } from "../app/blocks/catalog";
 import { outputNames, type AnyBlockDefinition, type BlockCategory } from "../app/engine/block";
+import { MAX_LAYOUT_BOXES, MAX_LAYOUT_TEXT } from "../app/engine/pipeline/pipeline-layout";
 
 /** Output paths, repo-relative. */
 export const BLOCKS_MD = "docs/blocks.md";
@@ -226,7 +227,7 @@ function pipelineSchema(blocks: readonly AnyBlockDefinition[]): JsonSchema {
         anyOf: [
           {
             type: "object",
-            properties: { BatchingMs: BATCHING_MS },
+            properties: { BatchingMs: BATCHING_MS, Layout: PIPELINE_LAYOUT },
             additionalProperties: false,
           },
           { $ref: "#/definitions/Block" },
@@ -238,6 +239,42 @@ function pipelineSchema(blocks: readonly AnyBlockDefinition[]): JsonSchema {
     definitions: { Block: block, ...definitions },
   };
 }
+
+/** A box of `Pipeline: { Layout }` with its text key (app/engine/pipeline/pipeline-layout.ts). */
+function layoutBox(textKey: string, text: string): JsonSchema {
+  const size = { type: "number", exclusiveMinimum: 0 };
+  return {
+    type: "object",
+    properties: {
+      [textKey]: { description: text, type: "string", maxLength: MAX_LAYOUT_TEXT },
+      X: { description: "Left edge on the canvas, px.", type: "number" },
+      Y: { description: "Top edge on the canvas, px.", type: "number" },
+      Width: { description: "Width, px.", ...size },
+      Height: { description: "Height, px.", ...size },
+    },
+    required: ["X", "Y", "Width", "Height"],
+    additionalProperties: false,
+  };
+}
+
+const PIPELINE_LAYOUT: JsonSchema = {
+  description:
+    "Boxes drawn on the canvas besides the blocks: groups (a titled box; the blocks inside it move with it) and comments (free text).",
+  type: "object",
+  properties: {
+    Groups: {
+      type: "array",
+      maxItems: MAX_LAYOUT_BOXES,
+      items: layoutBox("Title", "The group's title."),
+    },
+    Comments: {
+      type: "array",
+      maxItems: MAX_LAYOUT_BOXES,
+      items: layoutBox("Text", "The comment's text."),
+    },
+  },
+  additionalProperties: false,
+};
 
 const BATCHING_MS: JsonSchema = {
   description:

@@ -9,3 +9,9 @@ export {
   referencedBlock,
   type AddBlockOptions,
 } from "./pipeline/document";
+export {
+  pipelineLayoutValue,
+  type LayoutComment,
+  type LayoutGroup,
+  type PipelineLayout,
+} from "./pipeline/pipeline-layout";

@@ -8,6 +8,7 @@ import { z } from "zod";
 import type { PortMeta } from "./block";
 import type { Diagnostic } from "./diagnostics";
 import type { Shape } from "./frame";
+import type { PipelineLayout } from "./pipeline/pipeline-layout";
 import type { RuntimeEvent, Telemetry } from "./runtime/runtime";
 
 /**
@@ -196,6 +197,8 @@ export interface CatalogInfo {
 export interface GraphInfo {
   file: string;
   blocks: BlockInfo[];
+  /** The canvas's group and comment boxes (`Pipeline: { Layout }`), when the file has any. */
+  layout?: PipelineLayout;
   /** True when the pipeline was loaded with simulated devices. */
   simulateDevices?: boolean;
 }

@@ -551,7 +551,12 @@ export class EngineSession {
         ...(b.path !== undefined ? { path: b.path } : {}),
       };
     });
-    return { file: this.file, blocks, ...(this.simulated ? { simulateDevices: true } : {}) };
+    return {
+      file: this.file,
+      blocks,
+      ...(this.simulated ? { simulateDevices: true } : {}),
+      ...(this.spec!.settings.layout ? { layout: this.spec!.settings.layout } : {}),
+    };
   }
 
   private start(): void {

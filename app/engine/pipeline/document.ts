@@ -36,6 +36,7 @@ import { BLOCK_NAME_RE, loadPipeline, type LoadResult } from "./loader";
 import { mosaicType } from "./mosaic";
 import { parsePipelineYaml } from "./parse";
 import { positionalArgs } from "./positional";
+import { SETTINGS_KEY } from "./spec";
 
 export interface AddBlockOptions {
   inputs?: string[];
@@ -587,6 +588,61 @@ export class PipelineDocument {
     });
   }
 
+  /** A key of the settings entry `Pipeline:` as plain data (undefined: not set). */
+  setting(key: string): unknown {
+    const map = this.settingsMap();
+    const pair = map?.items.find((q) => keyOf(q) === key);
+    return pair ? ((pair.value as { toJSON?(): unknown } | null)?.toJSON?.() ?? null) : undefined;
+  }
+
+  /**
+   * Sets (undefined: removes) `key` of the settings entry `Pipeline:`, which is added at the end
+   * of the file when missing and removed with its last key. In a block-style entry the value is
+   * written in block style (mappings nested, list items one flow mapping a line), in a flow one
+   * on one line; other keys, comments outside the value and the blocks stay as they were.
+   */
+  setSetting(key: string, value: unknown): void {
+    const root = this.root();
+    const pair = this.findPair(SETTINGS_KEY);
+    if (pair && !this.settingsMap()) {
+      throw new Error(`'${SETTINGS_KEY}' is a block here; its settings cannot be written`);
+    }
+    const map = this.settingsMap();
+    if (value === undefined) {
+      const old = map?.items.find((q) => keyOf(q) === key);
+      if (!map || !old) return;
+      if (map.items.length === 1) this.apply([this.removeEntryEdit(root!, pair!)]);
+      else this.apply([this.removeEntryEdit(map, old)]);
+      return;
+    }
+    if (!map) {
+      this.appendEntry(
+        root?.flow === true
+          ? `${SETTINGS_KEY}: ${flowYaml({ [key]: value })}`
+          : `${SETTINGS_KEY}:${blockYaml({ [key]: value }, "  ", this.eol)}`,
+      );
+      return;
+    }
+    if (map.flow) {
+      this.apply([this.setEntryEdit(map, key, flowYaml(value))]);
+      return;
+    }
+    const first = map.items[0]?.key as YamlNode | undefined;
+    const at = first?.range?.[0];
+    const indent = at !== undefined ? " ".repeat(at - lineStart(this.text, at)) : "  ";
+    const entry = blockYaml({ [key]: value }, indent, this.eol).slice(
+      this.eol.length + indent.length,
+    );
+    const old = map.items.find((q) => keyOf(q) === key);
+    if (old) {
+      // The old entry's lines (and comments indented under it) give way to the new ones.
+      const gone = this.removeEntryEdit(map, old);
+      this.apply([{ ...gone, text: `${indent}${entry}${this.eol}` }]);
+    } else {
+      this.apply([this.newEntryEdit(map, entry, map.items[map.items.length - 1])]);
+    }
+  }
+
   /** Adds a line break at the end when the file has none (what `mosaic format` normalises). */
   normalize(): void {
     if (this.text !== "" && !this.text.endsWith("\n")) {
@@ -599,6 +655,12 @@ export class PipelineDocument {
   private root(): YAMLMap | null {
     const r = this.doc.contents;
     return isMap(r) ? r : null;
+  }
+
+  /** The settings entry's mapping (`Pipeline:` without a Type), if any. */
+  private settingsMap(): YAMLMap | undefined {
+    const v = this.findPair(SETTINGS_KEY)?.value;
+    return isMap(v) && !v.items.some((q) => keyOf(q) === "Type") ? v : undefined;
   }
 
   private findPair(name: string): Pair | undefined {
@@ -662,8 +724,12 @@ export class PipelineDocument {
   }
 
   private appendBlock(name: string, value: string): void {
+    this.appendEntry(`${scalarYaml(name)}: ${value}`);
+  }
+
+  /** Adds a top-level entry (its text) after the last one. */
+  private appendEntry(entry: string): void {
     const root = this.root();
-    const entry = `${scalarYaml(name)}: ${value}`;
     if (root) {
       this.apply([this.newEntryEdit(root, entry, root.items[root.items.length - 1])]);
       return;
@@ -901,6 +967,30 @@ function checkRate(rate: number): void {
   if (typeof rate !== "number" || !Number.isFinite(rate) || rate <= 0) {
     throw new Error(`DesiredRate must be a positive number of Hz, not ${String(rate)}`);
   }
+}
+
+/**
+ * A mapping in block style, each key on its own line at `indent` (text starting with a line
+ * break): nested mappings go deeper, a list of values is one `- <flow>` line per item, anything
+ * else (scalars, empty collections) stays on the key's line in flow style.
+ */
+function blockYaml(value: Record<string, unknown>, indent: string, eol: string): string {
+  let out = "";
+  for (const [k, v] of Object.entries(value)) {
+    if (v === undefined) continue;
+    out += `${eol}${indent}${scalarYaml(k)}:`;
+    if (isPlainRecord(v) && Object.keys(v).length > 0) out += blockYaml(v, `${indent}  `, eol);
+    else if (Array.isArray(v) && v.length > 0)
+      out += v.map((item) => `${eol}${indent}  - ${flowYaml(item ?? null)}`).join("");
+    else out += ` ${flowYaml(v)}`;
+  }
+  return out;
+}
+
+function isPlainRecord(v: unknown): v is Record<string, unknown> {
+  if (v === null || typeof v !== "object" || Array.isArray(v)) return false;
+  const proto = Object.getPrototypeOf(v) as unknown;
+  return proto === Object.prototype || proto === null;
 }
 
 function layoutYaml(p: { x: number; y: number }): string {

@@ -17,6 +17,7 @@ import {
   type MosaicTypeRule,
   type MosaicView,
 } from "./mosaic";
+import { readPipelineLayout } from "./pipeline-layout";
 import {
   BLOCK_KEYS,
   QUEUE_POLICIES,
@@ -361,12 +362,17 @@ export function isSettingsEntry(name: string | undefined, value: unknown): boole
   );
 }
 
-/** The settings entry `Pipeline: { BatchingMs }`. */
+/** The settings entry `Pipeline: { BatchingMs, Layout }`. */
 export function readSettings(c: Collector, node: YAMLMap, settings: PipelineSettings): void {
   for (const it of node.items) {
     const k = scalarString(it.key) ?? "";
     if (k === "BatchingMs") {
       settings.batchingMs = readBatchingMs(c, it.value, undefined);
+      continue;
+    }
+    if (k === "Layout") {
+      const layout = readPipelineLayout(c, it.value);
+      if (layout) settings.layout = layout;
       continue;
     }
     const suggestion = closest(k, SETTINGS_KEYS);

@@ -5,6 +5,7 @@
 import type { Document } from "yaml";
 import type { AnyBlockDefinition } from "../block";
 import type { Diagnostic } from "../diagnostics";
+import type { PipelineLayout } from "./pipeline-layout";
 
 export type QueuePolicy = "drop-oldest" | "drop-newest" | "latest";
 export const QUEUE_POLICIES: readonly QueuePolicy[] = ["drop-oldest", "drop-newest", "latest"];
@@ -59,6 +60,8 @@ export interface BlockSpec {
 export interface PipelineSettings {
   /** `BatchingMs`: how long a timer's ticks may wait to go out together, ms (DESIGN.md §3). */
   batchingMs: number | undefined;
+  /** `Layout`: the canvas's group and comment boxes (pipeline-layout.ts). */
+  layout?: PipelineLayout;
 }
 
 export interface PipelineSpec {
@@ -122,6 +125,6 @@ export const BLOCK_KEYS = [
 ] as const;
 /** The reserved top-level name for pipeline settings (a mapping without `Type`). */
 export const SETTINGS_KEY = "Pipeline";
-export const SETTINGS_KEYS = ["BatchingMs"] as const;
+export const SETTINGS_KEYS = ["BatchingMs", "Layout"] as const;
 export const BLOCK_NAME_RE = /^[A-Za-z_][A-Za-z0-9_-]*$/;
 export const WORKER_RE = /^[A-Za-z_][A-Za-z0-9_-]*$/;
