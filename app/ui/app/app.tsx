@@ -579,7 +579,7 @@ function Shell({
         </main>
 
         <footer className="footer">
-          <GestureLegend graph={graph} />
+          <GestureLegend graph={graph} onResult={onGesture} />
           <EventLog
             book={log}
             open={logOpen}

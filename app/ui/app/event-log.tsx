@@ -2,6 +2,7 @@
  * The log of the current load: its diagnostics, then runtime events (errors and warnings per
  * block) and the replies to actions; the counts beside it are this load's (./log-book.ts), so
  * they match the list and start again with every load. Earlier loads are kept, folded away.
+ * _Download_ saves the whole log (every load kept) as a JSON Lines file.
  */
 import { memo } from "react";
 import {
@@ -9,9 +10,12 @@ import {
   currentCounts,
   currentEntries,
   earlierEntries,
+  logFileName,
+  logJsonLines,
   type LogBook,
   type LogEntry,
 } from "./log-book";
+import { saveFile } from "./save-file";
 
 export type { LogEntry } from "./log-book";
 
@@ -62,6 +66,12 @@ function Counts({ book }: { book: LogBook }) {
   );
 }
 
+/** Saves the log as mosaic-log-DATE-TIME.jsonl through the browser's download. */
+function downloadLog(book: LogBook): void {
+  const bytes = new TextEncoder().encode(logJsonLines(book));
+  saveFile(logFileName(new Date()), "application/x-ndjson", bytes);
+}
+
 function EventLogComponent({
   book,
   open,
@@ -88,6 +98,16 @@ function EventLogComponent({
           <span aria-hidden="true">{open ? "▾" : "▸"}</span> Log
         </button>
         <Counts book={book} />
+        {book.entries.length > 0 ? (
+          <button
+            type="button"
+            className="event-log__clear"
+            title="Save the whole log (every load) as a JSON Lines file"
+            onClick={() => downloadLog(book)}
+          >
+            Download
+          </button>
+        ) : null}
         {open && book.entries.length > 0 ? (
           <button type="button" className="event-log__clear" onClick={onClear}>
             Clear

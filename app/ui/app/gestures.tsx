@@ -2,12 +2,13 @@
  * Keyboard-driven simulated EMG: keys 1–8 hold a gesture on every EmgSimulator block of the
  * pipeline (1 rest, 2 fist, … in the simulator's order), 0 or Space go back to rest. Keys typed
  * into a field, or with a modifier, are left alone. The legend shows the keys and the gesture
- * held now.
+ * held now; each of its entries is also a button (mouse and touch demos) that holds the gesture
+ * on every simulator that knows it.
  */
 import { useEffect, useMemo } from "react";
 import type { BlockInfo, GraphInfo } from "../../engine/protocol";
 import type { EngineClient } from "../client/engine-client";
-import { useTelemetrySelector } from "../client/hooks";
+import { useEngine, useTelemetrySelector } from "../client/hooks";
 import { gestureForKey, gestureNames } from "./gesture-names";
 
 function typingInto(target: EventTarget | null): boolean {
@@ -21,10 +22,25 @@ export function simulators(graph: GraphInfo | undefined): BlockInfo[] {
   return graph?.blocks.filter((b) => b.type === "EmgSimulator") ?? [];
 }
 
+/** What the page does with the reply to a gesture (a failure is shown, a success logged). */
+export type GestureResult = (message: string, ok: boolean, block: string) => void;
+
+/** Holds `gesture` on one simulator through its `setGesture` action. */
+function holdGesture(
+  client: EngineClient,
+  sim: BlockInfo,
+  gesture: string,
+  onResult: GestureResult,
+): void {
+  void client.invoke(sim.name, "setGesture", gesture).then((r) => {
+    onResult(r.message ?? (r.ok ? `gesture: ${gesture}` : "failed"), r.ok, sim.name);
+  });
+}
+
 export function useGestureKeys(
   client: EngineClient,
   graph: GraphInfo | undefined,
-  onResult: (message: string, ok: boolean, block: string) => void,
+  onResult: GestureResult,
 ): void {
   useEffect(() => {
     const sims = simulators(graph);
@@ -43,9 +59,7 @@ export function useGestureKeys(
         const g = gestureForKey(e.key, gestureNames(sim));
         if (g === undefined) continue;
         any = true;
-        void client.invoke(sim.name, "setGesture", g).then((r) => {
-          onResult(r.message ?? (r.ok ? `gesture: ${g}` : "failed"), r.ok, sim.name);
-        });
+        holdGesture(client, sim, g, onResult);
       }
       if (any) e.preventDefault();
     };
@@ -54,8 +68,18 @@ export function useGestureKeys(
   }, [client, graph, onResult]);
 }
 
-/** The legend of the gesture keys, with the gesture the (first) simulator holds now. */
-export function GestureLegend({ graph }: { graph: GraphInfo | undefined }) {
+/**
+ * The legend of the gesture keys, with the gesture the (first) simulator holds now. Every entry
+ * is a button: a click or a tap holds that gesture on every simulator that has it.
+ */
+export function GestureLegend({
+  graph,
+  onResult,
+}: {
+  graph: GraphInfo | undefined;
+  onResult: GestureResult;
+}) {
+  const client = useEngine();
   const sims = useMemo(() => simulators(graph), [graph]);
   const first = sims[0];
   const names = useMemo(() => (first ? gestureNames(first) : []), [first]);
@@ -65,10 +89,16 @@ export function GestureLegend({ graph }: { graph: GraphInfo | undefined }) {
     return names.includes(word) ? word : "";
   }, Object.is);
   if (!first) return null;
+  const hold = (gesture: string): void => {
+    for (const sim of sims) {
+      if (gestureNames(sim).includes(gesture)) holdGesture(client, sim, gesture, onResult);
+    }
+  };
+  const rest = gestureForKey("0", names);
   return (
-    <section className="gestures" aria-label="Simulated gestures (keyboard)">
+    <section className="gestures" aria-label="Simulated gestures (keys or buttons)">
       <h2 className="gestures__title">
-        Gesture keys
+        Gestures
         <span className="gestures__sub">
           {sims.length === 1 ? first.name : `${sims.length} simulators`}
         </span>
@@ -81,13 +111,46 @@ export function GestureLegend({ graph }: { graph: GraphInfo | undefined }) {
             aria-current={n === current ? "true" : undefined}
             data-gesture={n}
           >
-            <kbd>{i + 1}</kbd> {n}
+            <GestureButton gesture={n} keys={[String(i + 1)]} held={n === current} hold={hold} />
           </li>
         ))}
-        <li>
-          <kbd>0</kbd>/<kbd>Space</kbd> rest
-        </li>
+        {rest !== undefined ? (
+          <li>
+            <GestureButton gesture={rest} keys={["0", "Space"]} held={false} hold={hold} />
+          </li>
+        ) : null}
       </ol>
     </section>
+  );
+}
+
+/** One gesture of the legend: its key and name, a button that holds it. */
+function GestureButton({
+  gesture,
+  keys,
+  held,
+  hold,
+}: {
+  gesture: string;
+  keys: readonly string[];
+  held: boolean;
+  hold: (gesture: string) => void;
+}) {
+  return (
+    <button
+      type="button"
+      className="gestures__btn"
+      aria-pressed={held}
+      title={`Hold ${gesture} (key ${keys.join(" or ")})`}
+      onClick={() => hold(gesture)}
+    >
+      {keys.map((k, i) => (
+        <span key={k}>
+          {i > 0 ? "/" : ""}
+          <kbd>{k}</kbd>
+        </span>
+      ))}{" "}
+      {gesture}
+    </button>
   );
 }

@@ -9,6 +9,8 @@ import {
   earlierEntries,
   EMPTY_LOG,
   loadLines,
+  logFileName,
+  logJsonLines,
   MAX_LOG,
   startLoad,
   type LogBook,
@@ -122,5 +124,51 @@ describe("the event log's counts", () => {
     book = appendEntries(book, many);
     expect(book.entries).toHaveLength(MAX_LOG);
     expect(currentCounts(book).warnings).toBe(MAX_LOG);
+  });
+});
+
+describe("the Log's download (JSON Lines)", () => {
+  test("every entry, oldest first, one object per line, marked current or earlier", () => {
+    const next = { id: 1 };
+    let book = load(EMPTY_LOG, { file: "a.yaml", diagnostics: [warning(2)], replaced: true }, next);
+    book = load(book, { file: "b.yaml", diagnostics: [error], replaced: true }, next);
+    book = appendEntries(book, [
+      {
+        id: next.id++,
+        t: 1_700_000_000.25,
+        level: "info",
+        block: "Pred",
+        message: 'a "quoted"\nline',
+      },
+    ]);
+    const text = logJsonLines(book);
+    expect(text.endsWith("\n")).toBe(true);
+    const rows = text
+      .trimEnd()
+      .split("\n")
+      .map((l) => JSON.parse(l) as Record<string, unknown>);
+    expect(rows.map((r) => [r.level, r.block, r.currentLoad])).toEqual([
+      ["info", "", false],
+      ["warning", "p.yaml:2:3", false],
+      ["info", "", true],
+      ["error", "p.yaml:4:14", true],
+      ["info", "Pred", true],
+    ]);
+    expect(rows[0]!.message).toBe("loaded a.yaml: 1 warning");
+    expect(rows[3]!.message).toBe("unknown block type 'EmgSimulatr'; did you mean 'EmgSimulator'?");
+    // A message with quotes and a line break stays one line and reads back the same.
+    expect(rows[4]).toEqual({
+      time: "2023-11-14T22:13:20.250Z",
+      t: 1_700_000_000.25,
+      level: "info",
+      block: "Pred",
+      message: 'a "quoted"\nline',
+      currentLoad: true,
+    });
+    expect(logJsonLines(EMPTY_LOG)).toBe("");
+  });
+
+  test("the file is named from the local date and time", () => {
+    expect(logFileName(new Date(2026, 0, 24, 15, 30, 5))).toBe("mosaic-log-20260124-153005.jsonl");
   });
 });

@@ -136,3 +136,31 @@ export function loadLines(r: LoadReport): { level: LogLevel; block: string; mess
   if (r.error !== undefined) lines.push({ level: "error", block: r.file, message: r.error });
   return [head, ...lines];
 }
+
+/**
+ * The whole log (earlier loads and the current one, oldest first) as JSON Lines, for the Log's
+ * download: one object per entry with its ISO time, UNIX seconds, level, block, message and
+ * whether it belongs to the current load.
+ */
+export function logJsonLines(book: LogBook): string {
+  return book.entries
+    .map(
+      (e) =>
+        JSON.stringify({
+          time: new Date(e.t * 1000).toISOString(),
+          t: e.t,
+          level: e.level,
+          block: e.block,
+          message: e.message,
+          currentLoad: e.id >= book.currentFrom,
+        }) + "\n",
+    )
+    .join("");
+}
+
+/** The download's file name: mosaic-log-20260124-153005.jsonl (local time). */
+export function logFileName(at: Date): string {
+  const p = (n: number) => String(n).padStart(2, "0");
+  const day = `${at.getFullYear()}${p(at.getMonth() + 1)}${p(at.getDate())}`;
+  return `mosaic-log-${day}-${p(at.getHours())}${p(at.getMinutes())}${p(at.getSeconds())}.jsonl`;
+}
