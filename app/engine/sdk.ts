@@ -47,6 +47,7 @@ export {
   legacyPair,
   legacyVector,
 } from "./pipeline/legacy";
+export { RUST_BLOCK_ABI_VERSION, rustBlock, type RustBlockOptions } from "./rust-block";
 export type { CatchUp, TickCallback } from "./runtime/scheduler";
 
 /** The SDK's version: a user module may check it; it grows when the API grows. */

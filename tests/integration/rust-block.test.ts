@@ -1,0 +1,245 @@
+/**
+ * Rust blocks (issue 18): the template crate (templates/rust-block/) built with cargo for
+ * wasm32-unknown-unknown, loaded through `rustBlock` (app/engine/rust-block.ts) and run as a
+ * block: its output equals the NumPy reference (tests/fixtures/tkeo.json from gen_tkeo.py) bit
+ * for bit, does not depend on how events are split into frames, repeats after reset; a module of
+ * another ABI version, or no Rust block at all, is refused with what to do; a panic in the kernel
+ * is an error of its block, which goes on.
+ */
+import { spawnSync } from "node:child_process";
+import { cpSync, readFileSync, rmSync, writeFileSync } from "node:fs";
+import { join } from "node:path";
+import { afterAll, beforeAll, describe, expect, it } from "vitest";
+import { z } from "zod";
+import { Frame, vectorShape } from "../../app/engine/frame";
+import { RUST_BLOCK_ABI_VERSION, rustBlock } from "../../app/engine/rust-block";
+import { BlockHarness } from "../../app/engine/testing";
+import { ROOT, tempDir } from "./helpers";
+
+const TEMPLATE = join(ROOT, "templates", "rust-block");
+
+interface WasmGlobal {
+  Module: { new (bytes: Uint8Array): object; imports(module: object): unknown[] };
+  Instance: new (module: object, imports: object) => { exports: unknown };
+}
+
+interface TkeoFixture {
+  frames: number;
+  channels: number;
+  input: number[];
+  expected: number[];
+  expected_rectified: number[];
+}
+
+const fixture = JSON.parse(
+  readFileSync(join(TEMPLATE, "tests", "fixtures", "tkeo.json"), "utf8"),
+) as TkeoFixture;
+
+/** Copies the template to `dir` (without build outputs), applies `edits`, builds it; returns the .wasm bytes. */
+function buildTemplate(dir: string, edits: { file: string; from: string; to: string }[] = []) {
+  cpSync(TEMPLATE, dir, {
+    recursive: true,
+    filter: (src) => !src.includes(`${TEMPLATE}/target`) && !src.endsWith("Cargo.lock"),
+  });
+  for (const e of edits) {
+    const path = join(dir, e.file);
+    const text = readFileSync(path, "utf8");
+    if (!text.includes(e.from)) throw new Error(`${e.file} has no '${e.from}'`);
+    writeFileSync(path, text.replace(e.from, e.to));
+  }
+  const r = spawnSync(
+    "cargo",
+    ["build", "--release", "--target", "wasm32-unknown-unknown", "--quiet"],
+    { cwd: dir, encoding: "utf8", timeout: 240_000 },
+  );
+  if (r.status !== 0) throw new Error(`cargo build failed in ${dir}:\n${r.stderr}`);
+  return readFileSync(join(dir, "target", "wasm32-unknown-unknown", "release", "tkeo.wasm"));
+}
+
+function tkeoBlock(wasm: Uint8Array) {
+  return rustBlock({
+    type: "Tkeo",
+    category: "Features",
+    summary: "Teager–Kaiser energy of every channel, one sample late.",
+    help: "ψ[n] = x[n]² − x[n−1]·x[n+1] per channel.",
+    params: z.strictObject({
+      Rectify: z.boolean().default(false).describe("Output |ψ|"),
+    }),
+    wasm,
+    wasmName: "tkeo.wasm",
+  });
+}
+
+/** The fixture's input as frames of `sizes[i % sizes.length]` events (timestamps k / 1000). */
+function frames(sizes: readonly number[]): Frame[] {
+  const shape = vectorShape(fixture.channels);
+  const out: Frame[] = [];
+  let k = 0;
+  for (let i = 0; k < fixture.frames; i++) {
+    const n = Math.min(sizes[i % sizes.length]!, fixture.frames - k);
+    const t: number[] = [];
+    const v: number[][] = [];
+    for (let e = 0; e < n; e++, k++) {
+      t.push(k / 1000);
+      v.push(fixture.input.slice(k * fixture.channels, (k + 1) * fixture.channels));
+    }
+    out.push(Frame.from(shape, t, v));
+  }
+  return out;
+}
+
+async function harness(wasm: Uint8Array, params: unknown = {}): Promise<BlockHarness> {
+  return BlockHarness.create(tkeoBlock(wasm), params, {
+    inputs: [{ shape: vectorShape(fixture.channels), rate: 1000 }],
+  });
+}
+
+function outputValues(h: BlockHarness): number[] {
+  return h.out.get("out")!.v.flat();
+}
+
+let work: string;
+let tkeoWasm: Uint8Array;
+
+beforeAll(() => {
+  work = tempDir("mosaic-rust-block-");
+  tkeoWasm = buildTemplate(join(work, "tkeo"));
+}, 300_000);
+
+afterAll(() => {
+  rmSync(work, { recursive: true, force: true });
+});
+
+describe("the template's Tkeo block, built with cargo and loaded through rustBlock", () => {
+  it("imports nothing and speaks this MOSAIC's ABI version", () => {
+    // The WebAssembly global (Node's; this program is type-checked without the DOM library).
+    const wasm = (globalThis as unknown as { WebAssembly: WasmGlobal }).WebAssembly;
+    const module = new wasm.Module(tkeoWasm);
+    expect(wasm.Module.imports(module)).toEqual([]);
+    const x = new wasm.Instance(module, {}).exports as { mosaic_abi_version(): number };
+    expect(x.mosaic_abi_version()).toBe(RUST_BLOCK_ABI_VERSION);
+  });
+
+  it("equals the NumPy reference bit for bit, plain and rectified", async () => {
+    for (const [params, expected] of [
+      [{}, fixture.expected],
+      [{ Rectify: true }, fixture.expected_rectified],
+    ] as const) {
+      const h = await harness(tkeoWasm, params);
+      h.start();
+      for (const f of frames([fixture.frames])) h.push(f);
+      const got = outputValues(h);
+      expect(got.length).toBe(expected.length);
+      const differing = got.flatMap((v, i) => (Object.is(v, expected[i]) ? [] : [i]));
+      expect(differing).toEqual([]);
+      expect(h.out.get("out")!.t).toEqual(
+        Array.from({ length: fixture.frames }, (_, k) => k / 1000),
+      );
+    }
+    expect(fixture.expected.some((v) => v < 0)).toBe(true);
+  });
+
+  it("gives the same output however the events are split into frames", async () => {
+    for (const sizes of [[1], [2, 5, 1], [7], [64, 3], [599, 1]]) {
+      const h = await harness(tkeoWasm);
+      for (const f of frames(sizes)) h.push(f);
+      expect(outputValues(h)).toEqual(fixture.expected);
+      expect(h.out.get("out")!.frames.length).toBeGreaterThan(1);
+    }
+  });
+
+  it("repeats its output after reset, and disposes twice without error", async () => {
+    const h = await harness(tkeoWasm);
+    for (const f of frames([50])) h.push(f);
+    const first = outputValues(h);
+    h.instance.reset!();
+    h.out.get("out")!.v.length = 0;
+    for (const f of frames([33])) h.push(f);
+    expect(outputValues(h)).toEqual(first);
+    h.instance.dispose!();
+    h.instance.dispose!();
+  });
+
+  it("keeps a matrix input's shape and treats its values as channels", async () => {
+    const block = tkeoBlock(tkeoWasm);
+    const h = await BlockHarness.create(block, {}, { inputs: [{ shape: { rows: 2, cols: 2 } }] });
+    expect(h.ports[0]!.shape).toEqual({ rows: 2, cols: 2 });
+    h.push(
+      Frame.from(
+        { rows: 2, cols: 2 },
+        [0, 1, 2],
+        [
+          [1, 4, 4, 1],
+          [3, 2, 1, 0],
+          [1, 4, 4, 1],
+        ],
+      ),
+    );
+    // Value k: x0², then x1² − x0·x2 (one sample late).
+    expect(h.out.get("out")!.v).toEqual([
+      [0, 0, 0, 0],
+      [1, 16, 16, 1],
+      [3 * 3 - 1 * 1, 2 * 2 - 4 * 4, 1 * 1 - 4 * 4, 0 * 0 - 1 * 1],
+    ]);
+  });
+
+  it("refuses wrong params with the schema's message and a timer input with a sentence", async () => {
+    await expect(harness(tkeoWasm, { Rectify: "yes" })).rejects.toThrow(/Rectify/);
+    await expect(harness(tkeoWasm, { Gain: 2 })).rejects.toThrow(/Gain/);
+    await expect(
+      BlockHarness.create(
+        tkeoBlock(tkeoWasm),
+        {},
+        { inputs: [{ shape: { rows: 1, cols: 0 }, isTimer: true }] },
+      ),
+    ).rejects.toThrow("Tkeo processes a signal; its input in0 is a timer");
+  });
+});
+
+describe("modules rustBlock refuses, with what to do", () => {
+  it("a module of another ABI version", () => {
+    const v2 = buildTemplate(join(work, "abi2"), [
+      { file: "src/abi.rs", from: "ABI_VERSION: u32 = 1", to: "ABI_VERSION: u32 = 2" },
+    ]);
+    expect(() => tkeoBlock(v2)).toThrow(
+      "tkeo.wasm speaks Rust block ABI version 2, but this MOSAIC speaks version 1 " +
+        "(docs/rust-block-abi.md): update MOSAIC, or rebuild the block from this MOSAIC's template",
+    );
+  }, 300_000);
+
+  it("a WebAssembly module that is no Rust block, and bytes that are no module", () => {
+    const empty = new Uint8Array([0x00, 0x61, 0x73, 0x6d, 0x01, 0x00, 0x00, 0x00]);
+    expect(() => tkeoBlock(empty)).toThrow(
+      "tkeo.wasm is not a MOSAIC Rust block: it exports no mosaic_abi_version",
+    );
+    expect(() => tkeoBlock(new TextEncoder().encode("not wasm"))).toThrow(
+      /^tkeo\.wasm is not a valid WebAssembly module: /,
+    );
+  });
+});
+
+describe("a kernel that panics", () => {
+  it("is an error of its block, which then starts over and goes on", async () => {
+    const panicking = buildTemplate(join(work, "panics"), [
+      {
+        file: "src/tkeo.rs",
+        from: "let (x1, x2) = (self.previous[c], self.before_previous[c]);",
+        to: 'assert!(!x[c].is_nan(), "NaN input");\n                let (x1, x2) = (self.previous[c], self.before_previous[c]);',
+      },
+    ]);
+    const h = await harness(panicking);
+    const [a, b] = frames([300]);
+    h.push(a!);
+    const bad = Frame.from(vectorShape(3), [1], [[0, NaN, 0]]);
+    expect(() => h.push(bad)).toThrow(
+      /^tkeo\.wasm trapped in mosaic_process \(a Rust panic or an out-of-bounds access: .*unreachable.*\); the kernel was created anew, its history lost$/,
+    );
+    // After the trap the kernel starts from zeros again: its first two outputs are 0 and x0².
+    h.out.get("out")!.v.length = 0;
+    h.push(b!);
+    const got = h.out.get("out")!.v;
+    expect(got.length).toBe(300);
+    expect(got[0]).toEqual([0, 0, 0]);
+    expect(got[1]).toEqual(b!.toArrays().v[0]!.map((x) => x * x));
+  }, 300_000);
+});
