@@ -36,8 +36,8 @@ await build({
   outdir: "dist",
   splitting: true,
   chunkNames: "chunks/[name]-[hash]",
-  // Native modules cannot be bundled.
-  external: ["serialport", "@serialport/*", "@abandonware/noble", "electron", "koffi"],
+  // Native modules cannot be bundled; esbuild (loading users' block modules) runs its binary.
+  external: ["serialport", "@serialport/*", "@abandonware/noble", "electron", "koffi", "esbuild"],
 });
 await build({
   ...common,

@@ -227,7 +227,7 @@ function pipelineSchema(blocks: readonly AnyBlockDefinition[]): JsonSchema {
         anyOf: [
           {
             type: "object",
-            properties: { BatchingMs: BATCHING_MS, Layout: PIPELINE_LAYOUT },
+            properties: { BatchingMs: BATCHING_MS, Layout: PIPELINE_LAYOUT, Blocks: USER_BLOCKS },
             additionalProperties: false,
           },
           { $ref: "#/definitions/Block" },
@@ -239,6 +239,14 @@ function pipelineSchema(blocks: readonly AnyBlockDefinition[]): JsonSchema {
     definitions: { Block: block, ...definitions },
   };
 }
+
+/** `Pipeline: { Blocks }`: the pipeline's own block modules (docs/writing-blocks.md). */
+const USER_BLOCKS: JsonSchema = {
+  description:
+    "Modules defining extra block types for this pipeline (docs/writing-blocks.md): ES modules (.ts, .mts, .js, .mjs) whose default or named exports are defineBlock(...) definitions, each path relative to this file.",
+  type: "array",
+  items: { type: "string", pattern: "\\.(ts|mts|js|mjs)$" },
+};
 
 /** A box of `Pipeline: { Layout }` with its text key (app/engine/pipeline/pipeline-layout.ts). */
 function layoutBox(textKey: string, text: string): JsonSchema {

@@ -31,6 +31,7 @@ import type { IoBridges } from "./io";
 import type { RecordingFormats } from "./recording/format";
 import { SessionRecorder } from "./recording/session-recorder";
 import { validatePipeline } from "./validate";
+import { pipelineCatalog, type LoadedBlockModule, type ModuleLoader } from "./user-blocks";
 
 export interface LoopHandle {
   stop(): void;
@@ -57,7 +58,17 @@ export interface SessionPlatform {
    * Parses and validates a pipeline file off this thread (the Node host's loader thread, so that
    * a large file does not hold up other requests); `loadPipeline` here when absent.
    */
-  loadPipeline?(source: string, file: string): Promise<LoadResult>;
+  loadPipeline?(source: string, file: string, catalog?: Catalog): Promise<LoadResult>;
+  /**
+   * Loads a user's block module (`Pipeline: { Blocks }`, docs/writing-blocks.md); absent where
+   * modules cannot be loaded (the browser build): such a pipeline is refused, saying so.
+   */
+  blockModules?: ModuleLoader;
+  /**
+   * Watches the files the loaded pipeline's block modules were built from (replacing what it
+   * watched before; none: stop watching) and calls `changed` when one is saved.
+   */
+  watchBlocks?(files: string[], changed: (file: string) => void): void;
   /** Device and network bridges for blocks (the Node host's; none in the browser). */
   io?: IoBridges;
   /** The file formats session recordings (`record-start`) can write; none: it refuses. */
@@ -311,10 +322,13 @@ export class EngineSession {
       case "validate": {
         // What `mosaic validate` says of the text (app/engine/validate.ts); the running pipeline stays.
         const parse = this.platform.loadPipeline?.bind(this.platform);
-        const diagnostics = await validatePipeline(msg.source, msg.file, this.catalog, {
-          resources: this.platform.resources(msg.file),
-          ...(parse ? { parse } : {}),
-        });
+        const diagnostics = own.failed
+          ? own.diagnostics
+          : await validatePipeline(msg.source, msg.file, own.catalog, {
+              resources: this.platform.resources(msg.file),
+              ...(parse ? { parse: (text, f) => parse(text, f, own.catalog) } : {}),
+            });
+        const own = await this.ownBlocks(msg.source, msg.file);
         this.reply(msg.id, true, undefined, { diagnostics });
         return;
       }
@@ -405,9 +419,9 @@ export class EngineSession {
     simulateDevices = false,
   ): Promise<{ diagnostics: Diagnostic[]; graph?: GraphInfo }> {
     const parsed = this.platform.loadPipeline
-      ? await this.platform.loadPipeline(source, file)
-      : loadPipeline(source, file, this.catalog);
-    const loaded = withSimulatedDevices(parsed, this.catalog, simulateDevices ? {} : undefined);
+      ? await this.platform.loadPipeline(source, file, own.catalog)
+      : loadPipeline(source, file, own.catalog);
+    const loaded = withSimulatedDevices(parsed, own.catalog, simulateDevices ? {} : undefined);
     // A text that does not load leaves what runs running (issue 17, defect 4).
     if (!loaded.spec) return this.rejected(loaded.diagnostics);
     const rejected = await this.precheck(loaded.spec, file);
@@ -415,6 +429,8 @@ export class EngineSession {
     this.unload();
     this.file = file;
     this.simulated = simulateDevices;
+    const own = await this.ownBlocks(source, file);
+    if (own.failed) return this.rejected(own.diagnostics);
     const logs = this.platform.logs?.(file);
     const created = await Runtime.create({
       spec: loaded.spec,
@@ -444,6 +460,7 @@ export class EngineSession {
   }
 
   /**
+    this.useBlocks(own, source);
    * While a pipeline is loaded, the blocks of its replacement are first instantiated on a
    * virtual clock (as `validate` does) so that one that cannot be created does not stop it.
    */
@@ -461,11 +478,60 @@ export class EngineSession {
     return created.diagnostics.filter((d) => d.severity === "error");
   }
 
-  /** The catalog's metadata for the editor (built once: the catalog never changes). */
+  /** The loaded pipeline's own blocks (`Pipeline: { Blocks }`) and the text they came from. */
+  private blocks: { catalog: Catalog; modules: LoadedBlockModule[]; source: string } | undefined;
+
+  /** The catalog for a pipeline text: the built-in blocks and those of its `Blocks:` modules. */
+  private async ownBlocks(source: string, file: string) {
+    const own = await pipelineCatalog(source, file, this.catalog, this.platform.blockModules);
+    return { ...own, failed: own.diagnostics.some((d) => d.severity === "error") };
+  }
+
+  /** A pipeline with these blocks was loaded: the palette lists them, their files are watched. */
+  private useBlocks(own: { catalog: Catalog; modules: LoadedBlockModule[] }, source: string): void {
+    this.blocks = { catalog: own.catalog, modules: own.modules, source };
+    this.catalogCache = undefined;
+    const files = [...new Set(own.modules.flatMap((m) => m.inputs))];
+    this.platform.watchBlocks?.(files, (changed) => void this.reloadBlocks(changed));
+  }
+
+  /**
+   * A file of the loaded pipeline's block modules was saved: loads the pipeline again with the
+   * new code and restarts it when it ran; when the new code does not load, what runs stays and
+   * the log says why. Either way an event says what happened (hot reload, issue 18).
+   */
+  async reloadBlocks(changed: string): Promise<void> {
+    const blocks = this.blocks;
+    if (!this.rt || !blocks) return;
+    const name = changed.split(/[/\\]/).pop() ?? changed;
+    const running = this.state === "running";
+    const run = this.loading.then(() => this.load(this.file, blocks.source, this.simulated));
+    this.loading = run.catch(() => {});
+    const { diagnostics, graph } = await run;
+    const t = this.rt.clock.now();
+    if (!graph) {
+      const why = diagnostics.filter((d) => d.severity === "error").map((d) => d.message);
+      const message = `${name} changed but does not load, the previous version keeps running: ${why.join("; ")}`;
+      this.platform.post({
+        type: "event",
+        event: { t, level: "error", block: "user blocks", message },
+      });
+      return;
+    }
+    this.platform.post({ type: "graph", graph });
+    if (running) this.start();
+    const message = `reloaded ${name}: pipeline ${running ? "restarted" : "loaded again"}`;
+    this.platform.post({
+      type: "event",
+      event: { t, level: "info", block: "user blocks", message },
+    });
+  }
+
+  /** The catalog's metadata for the editor (built once per pipeline's own blocks). */
   private catalogCache: CatalogInfo | undefined;
   private catalogInfo(): CatalogInfo {
     if (this.catalogCache) return this.catalogCache;
-    const types = catalogTypes(this.catalog).map((d) => {
+    const types = catalogTypes(this.blocks?.catalog ?? this.catalog).map((d) => {
       let schema: unknown = {};
       try {
         schema = z.toJSONSchema(d.params, { io: "input", unrepresentable: "any" });

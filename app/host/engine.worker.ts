@@ -25,7 +25,9 @@ import { nodeLslBridge } from "../../native-bridges/lsl";
 import { nodeTcpBridge } from "../../native-bridges/tcp";
 import { nodeUdpBridge } from "../../native-bridges/udp";
 import { createPythonBridge } from "../../native-bridges/python";
+import { pipelineCatalog } from "../engine/user-blocks";
 import { flushWrites, nodeResources } from "./resources";
+import { loadBlockModule } from "./user-blocks";
 import { clockFromBase } from "./time-base";
 import type { HostToWorker, InitMessage, TelemetryReport, WorkerToHost } from "./worker-protocol";
 
@@ -87,9 +89,16 @@ async function create(msg: InitMessage): Promise<void> {
     });
     return;
   }
+  // The pipeline's own blocks (`Pipeline: { Blocks }`), loaded in this worker.
+  const own = await pipelineCatalog(msg.source, msg.file, catalog, loadBlockModule);
+  if (own.diagnostics.some((d) => d.severity === "error")) {
+    post({ type: "failed", diagnostics: own.diagnostics });
+    return;
+  }
+  const blocks = own.catalog;
   const loaded = withSimulatedDevices(
-    loadPipeline(msg.source, msg.file, catalog),
-    catalog,
+    loadPipeline(msg.source, msg.file, blocks),
+    blocks,
     msg.simulateDevices,
   );
   if (!loaded.spec) {
@@ -106,7 +115,7 @@ async function create(msg: InitMessage): Promise<void> {
   }
   const created = await Runtime.create({
     spec: loaded.spec,
-    catalog,
+    catalog: blocks,
     clock,
     virtual,
     resources: nodeResources(dirname(msg.file)),

@@ -12,10 +12,11 @@
  * Pipelines loaded by the hub's clients are confined to the folders the hub says (`confine`
  * before each load): their files (AllowedFolders in resources.ts) and `Path` logs.
  */
-import { readFileSync } from "node:fs";
+import { readFileSync, unwatchFile, watchFile } from "node:fs";
 import { dirname, isAbsolute, resolve } from "node:path";
 import { parentPort, Worker, workerData, type MessagePort } from "node:worker_threads";
 import { catalog } from "../blocks/catalog";
+import type { ModuleLoadResult } from "../engine/user-blocks";
 import { MonotonicClock } from "../engine/clock";
 import { errorMessage, type Diagnostic } from "../engine/diagnostics";
 import { initDsp } from "../engine/dsp";
@@ -41,6 +42,7 @@ import { createPythonBridge } from "../../native-bridges/python";
 import { sessionRecordingFormats } from "../blocks/recording/session-formats";
 import { AllowedFolders, nodeResources } from "./resources";
 import { clockFromBase } from "./time-base";
+import { loadBlockModule } from "./user-blocks";
 import type { HubToSession, SessionToHub } from "./session-protocol";
 
 /** Files up to this size are parsed here (a few milliseconds); larger ones in the loader. */
@@ -253,11 +255,14 @@ function runSession(port: MessagePort): void {
     return { ...r, ok: false, spec: undefined, diagnostics: [...r.diagnostics, ...errors] };
   }
 
-  /** Parses and validates `source`: here when small, in the loader thread otherwise. */
-  async function parse(source: string, file: string): Promise<LoadResult> {
+  /**
+   * Parses and validates `source`: here when small or when it has its own blocks (the loader
+   * thread knows only the built-in ones), in the loader thread otherwise.
+   */
+  async function parse(source: string, file: string, blocks = catalog): Promise<LoadResult> {
     const confined = allowed;
     let r: LoadResult | undefined;
-    if (source.length > INLINE_CHARS) {
+    if (source.length > INLINE_CHARS && blocks === catalog) {
       const got = await loader.load(source, file);
       if (typeof got === "string") {
         return {
@@ -278,8 +283,30 @@ function runSession(port: MessagePort): void {
       }
       if (got) r = fromPortable(got);
     }
-    r ??= loadPipeline(source, file, catalog);
+    r ??= loadPipeline(source, file, blocks);
     return confined ? checkPaths(r, file, confined) : r;
+  }
+
+  /** A user's block module, when the pipeline may run code from where it is (confinement). */
+  function blockModule(path: string): Promise<ModuleLoadResult> {
+    const confined = allowed;
+    return loadBlockModule(path, confined ? (f) => confined.check(f, "run code from") : undefined);
+  }
+
+  /** The files of the loaded pipeline's block modules, polled (an editor may save by renaming). */
+  let watched: string[] = [];
+  function watchBlocks(files: string[], changed: (file: string) => void): void {
+    for (const f of watched) unwatchFile(f);
+    watched = files;
+    let pending: NodeJS.Timeout | undefined;
+    for (const f of files) {
+      watchFile(f, { interval: 250, persistent: false }, (now, before) => {
+        if (now.mtimeMs === before.mtimeMs && now.size === before.size) return;
+        // One reload for a save that touches the file several times.
+        clearTimeout(pending);
+        pending = setTimeout(() => changed(f), 150);
+      });
+    }
   }
 
   const yieldNow = (fn: () => void): void => void setImmediate(fn);
@@ -307,6 +334,8 @@ function runSession(port: MessagePort): void {
       resources: (file) => nodeResources(folderOf(file), allowed ?? undefined),
       logs: (file) => logSink(file, allowed),
       loadPipeline: parse,
+      blockModules: blockModule,
+      watchBlocks,
       recordingFormats: sessionRecordingFormats,
       // The data folder when there is one, confined as the pipeline is.
       recordings: (file) => nodeResources(msg.dataDir ?? folderOf(file), allowed ?? undefined),

@@ -5,9 +5,11 @@ import { catalog } from "../blocks/catalog";
 import type { Diagnostic } from "../engine/diagnostics";
 import { dspReady, initDsp } from "../engine/dsp";
 import type { SimulateOptions } from "../engine/pipeline/simulate";
+import { pipelineCatalog } from "../engine/user-blocks";
 import { validatePipeline } from "../engine/validate";
 import { defaultWasmPath } from "./host";
 import { nodeResources } from "./resources";
+import { loadBlockModule } from "./user-blocks";
 
 /** Loads the DSP core into this thread (once). */
 export function loadDspFromDisk(path = defaultWasmPath()): void {
@@ -36,7 +38,9 @@ export async function validatePipelineFile(
     ];
   }
   loadDspFromDisk();
-  return validatePipeline(source, file, catalog, {
+  const own = await pipelineCatalog(source, file, catalog, loadBlockModule);
+  if (own.diagnostics.some((d) => d.severity === "error")) return own.diagnostics;
+  return validatePipeline(source, file, own.catalog, {
     resources: nodeResources(dirname(resolve(file))),
     ...(simulateDevices ? { simulateDevices } : {}),
   });

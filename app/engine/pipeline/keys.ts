@@ -20,10 +20,12 @@ import {
 import { readPipelineLayout } from "./pipeline-layout";
 import {
   BLOCK_KEYS,
+  BLOCK_MODULE_RE,
   QUEUE_POLICIES,
   SETTINGS_KEY,
   SETTINGS_KEYS,
   WORKER_RE,
+  type BlockModuleRef,
   type InputRef,
   type PipelineSettings,
   type QueuePolicy,
@@ -370,6 +372,10 @@ export function readSettings(c: Collector, node: YAMLMap, settings: PipelineSett
       settings.batchingMs = readBatchingMs(c, it.value, undefined);
       continue;
     }
+    if (k === "Blocks") {
+      settings.blocks = readBlockModules(c, it.value);
+      continue;
+    }
     if (k === "Layout") {
       const layout = readPipelineLayout(c, it.value);
       if (layout) settings.layout = layout;
@@ -381,6 +387,38 @@ export function readSettings(c: Collector, node: YAMLMap, settings: PipelineSett
       ...(suggestion !== undefined ? { suggestion } : {}),
     });
   }
+}
+
+/** `Blocks`: a list of module files (`.ts`, `.mts`, `.js`, `.mjs`), relative to the pipeline. */
+export function readBlockModules(c: Collector, node: unknown): BlockModuleRef[] {
+  const expected =
+    "a list of module files relative to this file, e.g. `Blocks: [blocks/smoother.ts]` (docs/writing-blocks.md)";
+  if (!isSeq(node)) {
+    c.error(
+      "bad-blocks",
+      c.pos(node as YamlNode),
+      `${SETTINGS_KEY}: Blocks has ${describeNode(node)}`,
+      {
+        expected,
+      },
+    );
+    return [];
+  }
+  const refs: BlockModuleRef[] = [];
+  for (const item of node.items) {
+    const path = scalarString(item);
+    const at = c.pos(item as YamlNode);
+    if (path === undefined || path.trim() === "") {
+      c.error("bad-blocks", at, `${SETTINGS_KEY}: a Blocks entry has ${describeNode(item)}`, {
+        expected,
+      });
+    } else if (!BLOCK_MODULE_RE.test(path)) {
+      c.error("bad-blocks", at, `${SETTINGS_KEY}: Blocks entry '${path}' is not a module file`, {
+        expected: "a file ending in .ts, .mts, .js or .mjs",
+      });
+    } else refs.push({ path, pos: at });
+  }
+  return refs;
 }
 
 /** `BatchingMs`: a number of milliseconds, 0 (a wake-up per tick) to 1000. */

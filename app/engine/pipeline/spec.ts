@@ -62,7 +62,18 @@ export interface PipelineSettings {
   batchingMs: number | undefined;
   /** `Layout`: the canvas's group and comment boxes (pipeline-layout.ts). */
   layout?: PipelineLayout;
+  /** `Blocks`: modules defining extra block types (docs/writing-blocks.md), as written. */
+  blocks?: BlockModuleRef[];
 }
+
+/** One entry of `Pipeline: { Blocks: [...] }`: a module file, relative to the pipeline file. */
+export interface BlockModuleRef {
+  path: string;
+  pos: SourcePos;
+}
+
+/** The files a `Blocks:` entry may name (ES modules; TypeScript is transpiled on load). */
+export const BLOCK_MODULE_RE = /\.(ts|mts|js|mjs)$/;
 
 export interface PipelineSpec {
   file: string;
@@ -125,6 +136,6 @@ export const BLOCK_KEYS = [
 ] as const;
 /** The reserved top-level name for pipeline settings (a mapping without `Type`). */
 export const SETTINGS_KEY = "Pipeline";
-export const SETTINGS_KEYS = ["BatchingMs", "Layout"] as const;
+export const SETTINGS_KEYS = ["BatchingMs", "Layout", "Blocks"] as const;
 export const BLOCK_NAME_RE = /^[A-Za-z_][A-Za-z0-9_-]*$/;
 export const WORKER_RE = /^[A-Za-z_][A-Za-z0-9_-]*$/;

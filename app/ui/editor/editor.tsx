@@ -60,6 +60,9 @@ function withApplied(issues: EditIssue[], applied: readonly Diagnostic[]): EditI
 export function Editor(props: EditorProps): ReactNode {
   const { client, graph, running, applying, onNotify } = props;
   const [catalog, setCatalog] = useState<CatalogInfo | undefined>();
+  // The catalog holds the loaded pipeline's own blocks too (`Pipeline: { Blocks }`): asked again
+  // when another pipeline, or a new version of its blocks, is loaded.
+  const loadedTypes = graph ? `${graph.file}:${graph.blocks.map((b) => b.type).join(",")}` : "";
   useEffect(() => {
     let live = true;
     void client.catalog().then((c) => {
@@ -69,7 +72,7 @@ export function Editor(props: EditorProps): ReactNode {
     return () => {
       live = false;
     };
-  }, [client, onNotify]);
+  }, [client, onNotify, loadedTypes]);
 
   const ed = useEditor(props.initialText, props.initialFile);
   const check = useValidation(client, ed.file, ed.text);

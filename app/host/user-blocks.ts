@@ -1,0 +1,198 @@
+/**
+ * Loads a user's block module in Node (docs/writing-blocks.md): esbuild bundles the file with
+ * what it imports (TypeScript transpiled, `.wasm` files as bytes, `mosaic/sdk` bound to this
+ * engine's own SDK object), and the bundle is imported from a data: URL. A module that fails names
+ * the reason, with the line and column of a syntax error. Results are kept per file until one of
+ * the files the module was built from changes (the editor validates on every pause in typing).
+ */
+import { existsSync, statSync } from "node:fs";
+import { dirname, isAbsolute, resolve } from "node:path";
+import { pathToFileURL } from "node:url";
+import type { Message, Plugin } from "esbuild";
+import { errorMessage } from "../engine/diagnostics";
+import * as sdk from "../engine/sdk";
+import type { ModuleLoadResult } from "../engine/user-blocks";
+
+/** Where a loaded module finds the SDK (the engine's own instance: its zod, its error classes). */
+const SDK_KEY = Symbol.for("mosaic.sdk");
+
+/** The import names that mean the SDK. */
+const SDK_IMPORT = /^(mosaic\/sdk|@mosaic\/sdk)$/;
+
+/** Makes `mosaic/sdk` resolvable for modules loaded in this thread. */
+export function installSdk(): void {
+  (globalThis as Record<symbol, unknown>)[SDK_KEY] = sdk;
+}
+
+/** The module text that stands for `mosaic/sdk` inside a user's bundle. */
+function sdkShim(): string {
+  const names = Object.keys(sdk).filter((n) => n !== "default");
+  return (
+    `const sdk = globalThis[Symbol.for("mosaic.sdk")];\n` +
+    `if (!sdk) throw new Error("mosaic/sdk is provided by MOSAIC when it loads a block module");\n` +
+    `export const { ${names.join(", ")} } = sdk;\n`
+  );
+}
+
+const sdkPlugin: Plugin = {
+  name: "mosaic-sdk",
+  setup(b) {
+    b.onResolve({ filter: SDK_IMPORT }, () => ({ path: "sdk", namespace: "mosaic-sdk" }));
+    b.onLoad({ filter: /.*/, namespace: "mosaic-sdk" }, () => ({
+      contents: sdkShim(),
+      loader: "js",
+    }));
+  },
+};
+
+interface CacheEntry {
+  stamps: Map<string, string>;
+  result: ModuleLoadResult;
+}
+const cache = new Map<string, CacheEntry>();
+
+/** A file's size and modification time, "" when it is gone. */
+function stamp(file: string): string {
+  try {
+    const s = statSync(file);
+    return `${s.size}:${s.mtimeMs}`;
+  } catch {
+    return "";
+  }
+}
+
+function fresh(e: CacheEntry): boolean {
+  for (const [f, s] of e.stamps) if (stamp(f) !== s) return false;
+  return true;
+}
+
+/** Says why a file may not be part of a module (outside the allowed folders), or undefined. */
+export type RefuseFile = (file: string) => string | undefined;
+
+/**
+ * Loads the module `path` (absolute), or says why it cannot. With `refuse`, every file the module
+ * is built from is checked before any of its code runs.
+ */
+export async function loadBlockModule(
+  path: string,
+  refuse?: RefuseFile,
+): Promise<ModuleLoadResult> {
+  const file = isAbsolute(path) ? path : resolve(path);
+  const hit = cache.get(file);
+  if (hit && fresh(hit)) return refused(hit.result.inputs, refuse) ?? hit.result;
+  const result = await loadUncached(file, refuse);
+  if (result.ok || !result.refused) {
+    cache.set(file, { stamps: new Map(result.inputs.map((f) => [f, stamp(f)])), result });
+  }
+  return result;
+}
+
+function refused(
+  inputs: string[],
+  refuse: RefuseFile | undefined,
+): (ModuleLoadResult & { refused: true }) | undefined {
+  for (const f of inputs) {
+    const why = refuse?.(f);
+    if (why !== undefined) return { ok: false, message: why, inputs, refused: true };
+  }
+  return undefined;
+}
+
+async function loadUncached(
+  file: string,
+  refuse: RefuseFile | undefined,
+): Promise<ModuleLoadResult & { refused?: true }> {
+  if (!existsSync(file)) return { ok: false, message: "no such file", inputs: [file] };
+  const first = refused([file], refuse);
+  if (first) return first;
+  installSdk();
+  const built = await bundle(file);
+  if (!built.ok) return built;
+  const inside = refused(built.inputs, refuse);
+  if (inside) return inside;
+  try {
+    const url = `data:text/javascript;base64,${Buffer.from(built.code).toString("base64")}`;
+    const exports = (await import(url)) as Record<string, unknown>;
+    return { ok: true, exports, inputs: built.inputs };
+  } catch (e) {
+    const where = errorLine(e, file);
+    return {
+      ok: false,
+      message: `its top level threw: ${errorMessage(e)}${where}`,
+      inputs: built.inputs,
+    };
+  }
+}
+
+/** " (line N)" of the user's file in an error's stack (the bundle's inline source map). */
+function errorLine(e: unknown, file: string): string {
+  const stack = e instanceof Error ? (e.stack ?? "") : "";
+  const name = file.split(/[/\\]/).pop() ?? file;
+  const m = new RegExp(`${name.replace(/[.*+?^${}()|[\]\\]/g, "\\$&")}:(\\d+):(\\d+)`).exec(stack);
+  return m ? ` (at ${name}:${m[1]}:${m[2]})` : "";
+}
+
+type Bundled =
+  { ok: true; code: string; inputs: string[] } | Extract<ModuleLoadResult, { ok: false }>;
+
+async function bundle(file: string): Promise<Bundled> {
+  const esbuild = await import("esbuild");
+  const dir = dirname(file);
+  try {
+    const r = await esbuild.build({
+      entryPoints: [file],
+      absWorkingDir: dir,
+      bundle: true,
+      write: false,
+      format: "esm",
+      platform: "node",
+      target: "node20",
+      sourcemap: "inline",
+      metafile: true,
+      logLevel: "silent",
+      plugins: [sdkPlugin],
+      loader: { ".wasm": "binary" },
+      banner: {
+        js: `import { createRequire as __mosaicRequire } from "node:module"; const require = __mosaicRequire(${JSON.stringify(pathToFileURL(file).href)});`,
+      },
+    });
+    const inputs = Object.keys(r.metafile.inputs)
+      .filter((k) => !/^[a-z-]+:/.test(k))
+      .map((k) => resolve(dir, k));
+    return { ok: true, code: r.outputFiles[0]!.text, inputs: inputs.length > 0 ? inputs : [file] };
+  } catch (e) {
+    const errors = (e as { errors?: Message[] }).errors ?? [];
+    return buildFailure(file, dir, errors, e);
+  }
+}
+
+/** The first build error: at its line in the module, or naming the imported file it is in. */
+function buildFailure(
+  file: string,
+  dir: string,
+  errors: Message[],
+  e: unknown,
+): Extract<ModuleLoadResult, { ok: false }> {
+  const first = errors[0];
+  const more = errors.length > 1 ? ` (and ${errors.length - 1} more)` : "";
+  if (!first) return { ok: false, message: errorMessage(e), inputs: [file] };
+  const loc = first.location;
+  const inputs = [file];
+  if (!loc) return { ok: false, message: `${first.text}${more}`, inputs };
+  const where = resolve(dir, loc.file);
+  if (where === file) {
+    return {
+      ok: false,
+      message: `${first.text}${more}`,
+      line: loc.line,
+      col: loc.column + 1,
+      inputs,
+    };
+  }
+  inputs.push(where);
+  return {
+    ok: false,
+    message: `${loc.file}:${loc.line}:${loc.column + 1}: ${first.text}${more}`,
+    inputs,
+  };
+}
