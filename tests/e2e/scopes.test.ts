@@ -73,4 +73,49 @@ describe.skipIf(!haveChromium)("scopes and panel views (browser build, Chromium)
     expect(app.errors).toEqual([]);
     await app.close();
   }, 90_000);
+
+  test("channels and outputs are named: EMG 1…8 and the gestures in legends, picker and labels", async () => {
+    const app = await openApp(chromium, served.url, "pipelines/examples/training.yaml");
+    const { page } = app;
+    const legend = (panel: string) =>
+      page.locator(`[data-panel="${panel}"] .mp-legend .mp-chip`).allTextContents();
+    await page.click('.block-node[data-block="Myo"]');
+    await page.waitForSelector('[data-panel="Myo"] .mp-legend .mp-chip');
+    expect(await legend("Myo")).toEqual(Array.from({ length: 8 }, (_, k) => `EMG ${k + 1}`));
+    // The channel picker's toggles.
+    await page.click('[data-panel="Myo"] .mp-picker > button');
+    expect(await page.locator('[data-panel="Myo"] .mp-toggles label').allTextContents()).toEqual(
+      Array.from({ length: 8 }, (_, k) => `EMG ${k + 1}`),
+    );
+
+    const gestures = ["fist", "open", "pinch", "flexion", "extension"];
+    await page.click('.block-node[data-block="Predictor"]');
+    await page.waitForSelector('[data-panel="Predictor"] .mp-legend .mp-chip');
+    expect(await legend("Predictor")).toEqual(gestures);
+    // The spider's spokes and the label view.
+    await page.click('[data-panel="Predictor"] [data-tab="spider"]');
+    await page.waitForSelector('[data-panel="Predictor"] [data-view="spider"]');
+    const spider = await page.getAttribute(
+      '[data-panel="Predictor"] [data-view="spider"] canvas',
+      "aria-label",
+    );
+    for (const g of gestures) expect(spider).toContain(g);
+    await page.click('[data-panel="Predictor"] [data-tab="label"]');
+    await page.waitForSelector('[data-panel="Predictor"] [data-view="label"] dt');
+    const dts = await page
+      .locator('[data-panel="Predictor"] section[aria-label="Output prediction"] dt')
+      .allTextContents();
+    expect(dts).toEqual(gestures);
+    // The fit output sends values once the first capture trains the model (about 3 s in).
+    await page.waitForSelector('[data-panel="Predictor"] section[aria-label="Output fit"] dt', {
+      timeout: 30_000,
+    });
+    const fit = await page
+      .locator('[data-panel="Predictor"] section[aria-label="Output fit"] dt')
+      .allTextContents();
+    expect(fit).toEqual(["samples", ...gestures.map((g) => `R² ${g}`)]);
+    await page.screenshot({ path: artifact("names-training.png") });
+    expect(app.errors).toEqual([]);
+    await app.close();
+  }, 90_000);
 });

@@ -98,7 +98,14 @@ export const BufferBlock = defineBlock({
     const W = T + D;
     // Aperiodic: it emits on request (MOSAIC set its rate to 0).
     if (ctx.declaredRate === undefined) ctx.setDesiredRate(0);
-    const out = ctx.output(vectorShape(W), "pairs");
+    // Rows [target…, data…] are named after both inputs' values when both name them.
+    const tl = trig.info.meta?.labels;
+    const dl = data.info.meta?.labels;
+    const out = ctx.output(
+      vectorShape(W),
+      "pairs",
+      tl?.length === T && dl?.length === D ? { labels: [...tl, ...dl] } : undefined,
+    );
     const maxRows = p.MaxRows;
     if (maxRows * W > MAX_VALUES) {
       throw new BlockConfigError(

@@ -30,6 +30,7 @@ import {
   saveModelFile,
   type ModelFileHost,
 } from "./model-file";
+import { predictorMeta } from "./output-names";
 
 /** MOSAIC's batch learning machines (Learning.cs). */
 const MACHINES = ["RidgeRegression", "RR_RFF"] as const;
@@ -220,8 +221,10 @@ export const BatchPredictor = defineBlock({
     const initialState = loaded?.state ?? null;
     let replaced = false;
 
-    const out = ctx.output(vectorShape(M), "prediction");
-    const fitOut = ctx.output(vectorShape(1 + M), "fit");
+    // Named after the pairs' target columns when the Buffer names them (a Stimulus's gestures).
+    const names = predictorMeta(pairsIn?.info.meta?.labels, M);
+    const out = ctx.output(vectorShape(M), "prediction", names?.prediction);
+    const fitOut = ctx.output(vectorShape(1 + M), "fit", names?.fit);
 
     let values = new Float64Array(Math.min(maxRows, 256) * W);
     let rows = 0;

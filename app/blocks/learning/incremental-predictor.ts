@@ -28,6 +28,7 @@ import {
   saveModelFile,
   type ModelFileHost,
 } from "./model-file";
+import { predictorMeta } from "./output-names";
 
 /** MOSAIC's incremental learning machines (Learning.cs). */
 const MACHINES = ["IncrementalRidgeRegression", "IncrementalRFF", "IncrementalLDA"] as const;
@@ -178,8 +179,10 @@ export const IncrementalPredictor = defineBlock({
     let model: LearningModel = loaded ? loaded.model : createModel(created);
     const initialState = loaded?.state ?? null;
 
-    const out = ctx.output(vectorShape(M), "prediction");
-    const fitOut = ctx.output(vectorShape(1 + M), "fit");
+    // The outputs are named after the target's columns when it names them (a Stimulus's gestures).
+    const names = predictorMeta(tgt?.size === M ? tgt.info.meta?.labels : undefined, M);
+    const out = ctx.output(vectorShape(M), "prediction", names?.prediction);
+    const fitOut = ctx.output(vectorShape(1 + M), "fit", names?.fit);
 
     const target = new Float64Array(M);
     let hasTarget = false;

@@ -11,7 +11,14 @@ import { timerInput } from "../shared/inputs";
 import { publish } from "../shared/named";
 import { SeededRandom } from "../shared/random";
 import { plural, TextThrottle } from "../shared/text";
-import { checkLabels, labelsSchema, seconds, targetVector, unknownLabel } from "./trigger";
+import {
+  checkLabels,
+  labelsSchema,
+  seconds,
+  targetColumnLabels,
+  targetVector,
+  unknownLabel,
+} from "./trigger";
 
 /**
  * What a Stimulus offers by its name (shared/named.ts, kind "Stimulus"): its trigger frames (the
@@ -268,9 +275,11 @@ export const Stimulus = defineBlock({
     }
     const dur = Float64Array.of(p.Rest, p.Rise, p.Hold, p.Capture, p.Fall, 0);
 
-    const target = ctx.output(vectorShape(T), "target");
+    // One-hot targets name their columns (fist, open, …): panels and predictors show them.
+    const columns = targetColumnLabels(names, targets);
+    const target = ctx.output(vectorShape(T), "target", columns && { labels: columns });
     const phaseOut = ctx.output(vectorShape(1), "phase");
-    const trigger = ctx.output(vectorShape(T), "trigger");
+    const trigger = ctx.output(vectorShape(T), "trigger", columns && { labels: columns });
     const cueOut = ctx.output(vectorShape(1), "cue");
 
     // `-Timer` (MOSAIC's form): subscribed only while the protocol runs.

@@ -63,6 +63,30 @@ export function checkLabels(
   }
 }
 
+/**
+ * Names of a target vector's columns, for panels and recordings (PortMeta labels): column k is
+ * named after the label whose target is one-hot at k (1 there, 0 elsewhere: fist [1, 0, 0] names
+ * column 0 "fist"). Undefined unless every column has exactly one such label.
+ */
+export function targetColumnLabels(
+  names: readonly string[],
+  targets: readonly ArrayLike<number>[],
+): string[] | undefined {
+  const width = targets[0]?.length ?? 0;
+  if (width === 0) return undefined;
+  const cols: (string | null | undefined)[] = new Array<undefined>(width).fill(undefined);
+  names.forEach((name, i) => {
+    const v = targets[i]!;
+    let hot = -1;
+    for (let k = 0; k < v.length; k++) {
+      if (v[k] === 1 && hot === -1) hot = k;
+      else if (v[k] !== 0) return;
+    }
+    if (hot >= 0) cols[hot] = cols[hot] === undefined ? name : null;
+  });
+  return cols.every((c) => typeof c === "string") ? (cols as string[]) : undefined;
+}
+
 /** "unknown label 'fsit' (labels: rest, fist); did you mean 'fist'?" */
 export function unknownLabel(name: string, names: readonly string[]): string {
   const s = closest(name, names);
@@ -338,7 +362,8 @@ export const Trigger = defineBlock({
     let condParams: Condition = checkCondition(p.Condition ?? { Channel: 0, Above: 0.5 });
     let condOn = false;
 
-    const target = ctx.output(vectorShape(T), "target");
+    const columns = targetColumnLabels(names, targets);
+    const target = ctx.output(vectorShape(T), "target", columns && { labels: columns });
     const labelOut = ctx.output(vectorShape(1), "label");
 
     const sched = expandSchedule(p, names);

@@ -286,8 +286,11 @@ export const EmgSimulator = defineBlock({
     } catch (e) {
       throw new BlockConfigError(`cannot create the EMG generator: ${errorMessage(e)}`);
     }
-    const emg = ctx.output(vectorShape(channels), "emg");
-    const oneHot = ctx.output(vectorShape(names.length), "gesture");
+    const emg = ctx.output(vectorShape(channels), "emg", {
+      labels: Array.from({ length: channels }, (_, k) => `EMG ${k + 1}`),
+      unit: "mV",
+    });
+    const oneHot = ctx.output(vectorShape(names.length), "gesture", { labels: names });
 
     const seq = p.Sequence;
     // Cue inputs: a simulated participant following cues (every input after the timer).

@@ -20,7 +20,7 @@ import {
 import { fitCanvas, readTheme, useWidth, type Theme } from "./canvas";
 import { REDUCE_LABEL, RangeInputs, ReduceControls, withAlpha } from "./controls";
 import { countDraw, onFrame, viewStats } from "./frame";
-import type { ViewProps } from "./view-props";
+import type { OutputInfo, ViewProps } from "./view-props";
 
 export interface SpiderSettings {
   /** undefined: latest below 100 Hz, envelope above (raw EMG). */
@@ -155,7 +155,7 @@ export function SpiderPlot({
         <canvas
           ref={canvas}
           role="img"
-          aria-label={`Spider plot of ${block.name}.${output.name}: ${n} axes`}
+          aria-label={`Spider plot of ${block.name}.${output.name}: ${n} axes (${axisNames(output, n)})`}
         />
       </div>
       <p className="mp-foot">
@@ -169,6 +169,12 @@ export function SpiderPlot({
       </p>
     </div>
   );
+}
+
+/** The axes' names for the plot's text alternative ("fist, open, pinch", the first 32). */
+function axisNames(output: OutputInfo, n: number): string {
+  const names = Array.from({ length: Math.min(n, 32) }, (_, k) => channelLabel(output, k));
+  return names.join(", ") + (n > 32 ? ", …" : "");
 }
 
 function drawSpider(
@@ -247,7 +253,7 @@ function drawSpider(
   // Ring values on top, between the first two axes, on a light backing.
   const step = ticks.length > 1 ? ticks[1]! - ticks[0]! : span;
   const la = n >= 2 ? (angle(0) + angle(1)) / 2 : angle(0) + Math.PI / 4;
-  ctx.font = "10px system-ui, sans-serif";
+  ctx.font = "11px system-ui, sans-serif";
   ctx.textAlign = "center";
   ctx.textBaseline = "middle";
   ticks.forEach((t) => {
