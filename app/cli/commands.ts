@@ -3,6 +3,7 @@
  *
  *   mosaic validate FILE...            exit 0 when valid, 2 with file:line:col messages otherwise
  *   mosaic format FILE... [--check]    canonical round trip through the editor's document model
+ *   mosaic test-block FILE...          the block contract on a user's block module
  *   mosaic run FILE [options]          live per-block table (or --json lines); Ctrl-C stops cleanly
  *   mosaic bench [options]             the standard performance suite (see `mosaic bench --help`)
  *   mosaic simulate DEVICE [options]   a device simulator (app/devices/) until Ctrl-C
@@ -25,6 +26,7 @@ import type { BleBridge } from "../engine/io";
 import { renderTable } from "./table";
 
 const VERSION = "0.1.0";
+import { cmdTestBlock, testBlockHelp } from "./test-block";
 
 const HELP = `mosaic ${VERSION} — run MOSAIC pipelines headless
 
@@ -35,6 +37,7 @@ Usage:
       --simulate-devices, checks the pipeline as \`mosaic run --simulate-devices\` would run it.
   mosaic format FILE... [--check]
       Loads each pipeline through the editor's document model (the code the visual editor saves
+${testBlockHelp()}
       with) and writes it back in canonical form: a no-op on a valid file except that a missing
       final line break is added (comments, key order and styles are kept). An invalid file is
       never written: its messages are printed (file:line:col) and the exit code is 2. --check
@@ -602,6 +605,8 @@ async function dispatch(cmd: string | undefined, rest: string[]): Promise<number
     case "format":
       return cmdFormat(rest);
     case "run":
+    case "test-block":
+      return cmdTestBlock(rest, out, err);
       return cmdRun(rest);
     case "bench":
       return runBench(rest);
