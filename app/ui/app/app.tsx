@@ -11,6 +11,7 @@ import type { EngineWhere } from "../client/connection-status";
 import { EngineContext, useEngine, useEngineInfo, useEngineState } from "../client/hooks";
 import { BlockTable } from "../graph/block-table";
 import { StimulusOverlay } from "../stimulus/stimulus-view";
+import { ParticipantButton } from "../stimulus/participant-button";
 import { Editor, EMPTY_FILE } from "../editor/editor";
 import { Diagnostics } from "./diagnostics";
 import { ConnectionLost, EngineBadge, useConnectionLoss, type LossSource } from "./engine-badge";
@@ -436,6 +437,7 @@ function Shell({
           </button>
           <label
             className="toggle simulate-devices"
+          {stimuli.length > 0 ? <ParticipantButton block={stimuli[0]!.name} /> : null}
             title={
               "Replace device blocks (Myo, Muovi, Delsys, NilsPod, …) by simulators of the same " +
               "shape and rate, and output devices (BlenderArm, Hannes, UDP, ROS) by blocks that " +

@@ -7,9 +7,8 @@
 import { useCallback, useEffect, useMemo, useRef, useState } from "react";
 import type { BlockInfo, DataMessage } from "../../engine/protocol";
 import { useBlockData, useEngine, useTelemetrySelector } from "../client/hooks";
+import { PHASES, cueLabels, type Phase } from "./cues";
 
-export const PHASES = ["rest", "rise", "hold", "capture", "fall", "end"] as const;
-export type Phase = (typeof PHASES)[number];
 const PHASE_PARAM: Record<Phase, string | undefined> = {
   rest: "Rest",
   rise: "Rise",
@@ -26,28 +25,6 @@ const PHASE_DEFAULT: Record<Phase, number> = {
   fall: 1,
   end: 0,
 };
-
-/** Label names in cue-index order, as the Stimulus block numbers them (Labels, then Tasks). */
-export function cueLabels(params: Record<string, unknown>): string[] {
-  const names: string[] = [];
-  const labels = params.Labels;
-  if (labels !== null && typeof labels === "object" && !Array.isArray(labels)) {
-    names.push(...Object.keys(labels));
-  }
-  const tasks = params.Tasks;
-  if (Array.isArray(tasks)) {
-    for (const t of tasks) {
-      const label =
-        typeof t === "string"
-          ? t
-          : t !== null && typeof t === "object"
-            ? (t as { Label?: unknown }).Label
-            : undefined;
-      if (typeof label === "string" && !names.includes(label)) names.push(label);
-    }
-  }
-  return names;
-}
 
 /** What the participant is asked to do in a phase. */
 export function instruction(phase: Phase | undefined, label: string): string {
