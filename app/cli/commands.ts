@@ -8,6 +8,7 @@
  *   mosaic bench [options]             the standard performance suite (see `mosaic bench --help`)
  *   mosaic simulate DEVICE [options]   a device simulator (app/devices/) until Ctrl-C
  *   mosaic repair FILE...              makes an interrupted recording (XDF) whole again
+ *   mosaic new-block --rust NAME [DIR] a block written in Rust, from templates/rust-block
  */
 import { readFileSync, statSync, writeFileSync } from "node:fs";
 import { dirname, join, resolve } from "node:path";
@@ -19,14 +20,15 @@ import type { Telemetry } from "../engine/runtime/runtime";
 import { Host, webRoot } from "../host/host";
 import { serveStatic } from "../host/web-server";
 import { runBench } from "./bench";
+import { cmdNewBlock, newBlockHelp } from "./new-block";
 import { cmdRepair, repairHelp } from "./repair";
 import { cmdSimulate, simulateHelp } from "./simulate";
 import { NilsPodSimulator } from "../devices/nilspod-simulator";
 import type { BleBridge } from "../engine/io";
 import { renderTable } from "./table";
+import { cmdTestBlock, testBlockHelp } from "./test-block";
 
 const VERSION = "0.1.0";
-import { cmdTestBlock, testBlockHelp } from "./test-block";
 
 const HELP = `mosaic ${VERSION} — run MOSAIC pipelines headless
 
@@ -35,9 +37,9 @@ Usage:
       Checks pipeline files (YAML syntax, block types, params, wiring, shapes, files they read).
       Exit 0 when every file is valid, 2 otherwise; messages are file:line:col. With
       --simulate-devices, checks the pipeline as \`mosaic run --simulate-devices\` would run it.
+${testBlockHelp()}
   mosaic format FILE... [--check]
       Loads each pipeline through the editor's document model (the code the visual editor saves
-${testBlockHelp()}
       with) and writes it back in canonical form: a no-op on a valid file except that a missing
       final line break is added (comments, key order and styles are kept). An invalid file is
       never written: its messages are printed (file:line:col) and the exit code is 2. --check
@@ -89,6 +91,7 @@ ${testBlockHelp()}
       can be demonstrated without the hardware; prints where it listens, runs until Ctrl-C.
 ${simulateHelp()}
 ${repairHelp()}
+${newBlockHelp()}
   mosaic --help | --version
 `;
 
@@ -602,11 +605,11 @@ async function dispatch(cmd: string | undefined, rest: string[]): Promise<number
       return 0;
     case "validate":
       return cmdValidate(rest);
+    case "test-block":
+      return cmdTestBlock(rest, out, err);
     case "format":
       return cmdFormat(rest);
     case "run":
-    case "test-block":
-      return cmdTestBlock(rest, out, err);
       return cmdRun(rest);
     case "bench":
       return runBench(rest);
@@ -618,9 +621,11 @@ async function dispatch(cmd: string | undefined, rest: string[]): Promise<number
       return cmdSimulate(rest, out, err);
     case "repair":
       return cmdRepair(rest, out, err);
+    case "new-block":
+      return cmdNewBlock(rest, out, err);
     default:
       err(
-        `mosaic: unknown command '${cmd}' (commands: validate, format, run, web, serve, bench, simulate, repair; see mosaic --help)`,
+        `mosaic: unknown command '${cmd}' (commands: validate, format, run, web, serve, bench, simulate, repair, new-block; see mosaic --help)`,
       );
       return 2;
   }
