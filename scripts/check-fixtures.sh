@@ -24,6 +24,7 @@ GENERATORS=(
   "app/blocks/signal/fixtures/gen_dds.py:dds.json"
   "app/blocks/signal/fixtures/gen_envelope.py:envelope_5hz.csv"
   "app/blocks/kinematics/fixtures/gen_body_rig.py:body_rig.json"
+  "app/ui/panels/fixtures/gen_spectrum.py:spectrum.json"
 )
 
 # uv as installed by scripts/setup.sh (pip --user: `python3 -m uv`), or on PATH.
