@@ -122,7 +122,13 @@ interface WorkerState {
   serial?: ReturnType<typeof serialHub>;
   /** The worker's Bluetooth LE (noble runs here, not in workers: native-bridges/ble.ts). */
   ble?: ReturnType<typeof bleHub>;
+  /** When the worker last sent anything (ms, Date.now), and whether its silence was reported. */
+  heardAt: number;
+  silent: boolean;
 }
+
+/** A running worker silent this long (it sends telemetry at 20 Hz) is reported as stuck. */
+export const STUCK_WORKER_MS = 3000;
 
 export interface LoadOutcome {
   host: Host | undefined;
@@ -276,7 +282,15 @@ export class Host {
       // A small young generation keeps the worker's footprint down; its garbage is tiny.
       resourceLimits: { maxYoungGenerationSizeMb: 4 },
     });
-    const st: WorkerState = { name, worker, stopped: false, exited: false, waiters: [] };
+    const st: WorkerState = {
+      name,
+      worker,
+      stopped: false,
+      exited: false,
+      waiters: [],
+      heardAt: Date.now(),
+      silent: false,
+    };
     this.workers.set(name, st);
     worker.on("message", (m: WorkerToHost) => this.onMessage(st, m));
     worker.on("error", (e) => {
@@ -323,6 +337,8 @@ export class Host {
   }
 
   private onMessage(st: WorkerState, m: WorkerToHost): void {
+    st.heardAt = Date.now();
+    if (st.silent) this.answersAgain(st);
     st.waiters = st.waiters.filter((w) => !w(m));
     switch (m.type) {
       case "log-open":
@@ -427,7 +443,57 @@ export class Host {
   }
 
   start(): void {
-    for (const w of this.workers.values()) this.post(w, { type: "start" } satisfies HostToWorker);
+    for (const w of this.workers.values()) {
+      w.heardAt = Date.now();
+      this.post(w, { type: "start" } satisfies HostToWorker);
+    }
+    if (this.options.mode === "realtime") {
+      this.watchdog = setInterval(() => this.checkSilence(), 500);
+      this.watchdog.unref();
+    }
+  }
+
+  private watchdog: NodeJS.Timeout | undefined;
+
+  /** The names of the blocks a worker runs, for an event's block ("Loop, Other"). */
+  private blockNames(worker: string): string {
+    const blocks = (this.plan?.blocks ?? []).filter((b) => b.worker === worker);
+    return blocks.map((b) => b.name).join(", ") || `worker ${worker}`;
+  }
+
+  /** The blocks a worker runs, for messages ("'Loop' (Looper)"). */
+  private blocksOn(worker: string): string {
+    const blocks = (this.plan?.blocks ?? []).filter((b) => b.worker === worker);
+    return blocks.map((b) => `'${b.name}' (${b.type})`).join(", ") || "none";
+  }
+
+  /**
+   * A worker that stopped sending telemetry is stuck inside a block (an endless loop in
+   * `process`): said once, naming its blocks, while the other workers go on.
+   */
+  private checkSilence(): void {
+    const now = Date.now();
+    for (const w of this.workers.values()) {
+      if (w.stopped || w.exited || w.silent || now - w.heardAt < STUCK_WORKER_MS) continue;
+      w.silent = true;
+      const s = ((now - w.heardAt) / 1000).toFixed(1);
+      this.events.event?.({
+        t: now / 1000,
+        level: "error",
+        block: this.blockNames(w.name),
+        message: `engine worker '${w.name}' has not answered for ${s} s: its blocks ${this.blocksOn(w.name)} are stuck (an endless loop in process?); the other workers go on`,
+      });
+    }
+  }
+
+  private answersAgain(w: WorkerState): void {
+    w.silent = false;
+    this.events.event?.({
+      t: Date.now() / 1000,
+      level: "info",
+      block: this.blockNames(w.name),
+      message: `engine worker '${w.name}' answers again`,
+    });
   }
 
   private reportTelemetry(): void {
@@ -516,11 +582,13 @@ export class Host {
   /** Stops every worker, waits for their final telemetry, flushes and closes the logs. */
   stop(timeoutMs = 5000): Promise<Telemetry> {
     if (this.stopping) return this.stopping;
+    clearInterval(this.watchdog);
     this.stopping = (async () => {
       await Promise.all(
         [...this.workers.values()].map((w) => {
           w.stopped = true;
-          if (w.exited) return Promise.resolve();
+          // A stuck worker (checkSilence) will not answer: it is terminated below.
+          if (w.exited || w.silent) return Promise.resolve();
           let timer: NodeJS.Timeout | undefined;
           return Promise.race([
             this.request(w, { type: "stop" }, (m) => m.type === "stopped" || m.type === "fatal"),
