@@ -47,14 +47,21 @@ describe("mosaic new-block --rust", () => {
     expect(existsSync(join(r.dir, "Cargo.lock"))).toBe(false);
   });
 
-  it("says what to run next, with paths from where it was run", () => {
+  it("says what to run next, with paths as typed from where it was run", () => {
     const parent = temp();
     const r = createRustBlock("tkeo", parent);
-    const text = nextSteps(r, parent);
-    expect(text).toContain("cd tkeo && cargo build --release --target wasm32-unknown-unknown");
-    expect(text).toContain("Pipeline: { Blocks: [tkeo/block.ts] }");
-    expect(text).toContain("Energy: { Type: Tkeo, Inputs: [YourSignal] }");
-    expect(text).toContain("mosaic test-block tkeo/block.ts");
+    const here = nextSteps(r, parent);
+    expect(here).toContain("cd tkeo && cargo build --release --target wasm32-unknown-unknown");
+    expect(here).toContain("use it in a pipeline in ./ (Blocks: paths are relative");
+    expect(here).toContain("Pipeline: { Blocks: [tkeo/block.ts] }");
+    expect(here).toContain("Energy: { Type: Tkeo, Inputs: [YourSignal] }");
+    expect(here).toContain("mosaic test-block tkeo/block.ts");
+    // Run from elsewhere (`mosaic new-block --rust tkeo /tmp/x`): absolute paths, same Blocks line.
+    const elsewhere = nextSteps(r, join(parent, "..", "somewhere-else"));
+    expect(elsewhere).toContain(`cd ${r.dir} && cargo build`);
+    expect(elsewhere).toContain(`use it in a pipeline in ${parent}/`);
+    expect(elsewhere).toContain("Pipeline: { Blocks: [tkeo/block.ts] }");
+    expect(elsewhere).toContain(`mosaic test-block ${r.dir}/block.ts`);
   });
 
   it("refuses a name that cannot name a crate and a folder that is not empty", () => {

@@ -4,7 +4,7 @@
  * it and use it in a pipeline (docs/writing-blocks.md, "Rust blocks").
  */
 import { cpSync, existsSync, readdirSync, readFileSync, writeFileSync } from "node:fs";
-import { dirname, join, relative, resolve, sep } from "node:path";
+import { basename, dirname, isAbsolute, join, relative, resolve, sep } from "node:path";
 import { fileURLToPath } from "node:url";
 import { parseArgs } from "node:util";
 
@@ -97,19 +97,27 @@ export function createRustBlock(
   return { dir, type, libName };
 }
 
-/** The lines that tell the user what to do next. */
+/** `path` as the user may type it from `cwd`: relative below it, else absolute. */
+function shownPath(path: string, cwd: string): string {
+  const rel = relative(cwd, path);
+  if (rel === "") return ".";
+  return rel.startsWith("..") || isAbsolute(rel) ? path : rel;
+}
+
+/** The lines that tell the user what to do next (paths as typed from `cwd`). */
 export function nextSteps(made: NewRustBlock, cwd: string): string {
-  const shown = relative(cwd, made.dir) || ".";
-  const blockFile = `${shown}/block.ts`.replaceAll("\\", "/");
+  const crate = shownPath(made.dir, cwd).replaceAll("\\", "/");
+  const parent = shownPath(dirname(made.dir), cwd).replaceAll("\\", "/");
+  const name = basename(made.dir);
   return [
-    `created ${shown}/: the Rust block ${made.type} (its kernel: src/tkeo.rs; its block: block.ts)`,
+    `created ${crate}/: the Rust block ${made.type} (its kernel: src/tkeo.rs; its block: block.ts)`,
     "build it (and after every change to src/):",
-    `  cd ${shown} && cargo build --release --target wasm32-unknown-unknown`,
-    "use it in a pipeline (the path relative to the pipeline file):",
-    `  Pipeline: { Blocks: [${blockFile}] }`,
+    `  cd ${crate} && cargo build --release --target wasm32-unknown-unknown`,
+    `use it in a pipeline in ${parent}/ (Blocks: paths are relative to the pipeline file):`,
+    `  Pipeline: { Blocks: [${name}/block.ts] }`,
     `  Energy: { Type: ${made.type}, Inputs: [YourSignal] }`,
     "check it:",
-    `  mosaic test-block ${blockFile}`,
+    `  mosaic test-block ${crate}/block.ts`,
     "(docs/writing-blocks.md, 'Rust blocks'; needs: rustup target add wasm32-unknown-unknown)",
   ].join("\n");
 }
