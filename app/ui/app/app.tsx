@@ -19,6 +19,7 @@ import { EventLog } from "./event-log";
 import { GestureLegend, useGestureKeys } from "./gestures";
 import { setBlockParam } from "../graph/layout-yaml";
 import { PanelHost, type EditStatic, type OpenPanel } from "./panel-host";
+import { PresentationToggle } from "./presentation";
 import { RecordControl } from "./record";
 import { saveFile } from "./save-file";
 import { UiContext, type UiActions } from "./ui-context";
@@ -469,6 +470,7 @@ function Shell({
             {!info.connected
               ? loss
                 ? "not connected"
+          <PresentationToggle />
                 : "engine starting…"
               : info.sharedMemory
                 ? "precise timing (shared memory)"

@@ -8,6 +8,7 @@ import { useEffect, useRef, useState, type ReactNode } from "react";
 import type { BlockInfo } from "../../engine/protocol";
 import type { SetResult } from "../forms/params-form";
 import { BlockPanel } from "../panels/block-panel";
+import { useAvoidNode } from "./use-avoid-node";
 import { StatusDot } from "./status-dot";
 import { useUi } from "./ui-context";
 
@@ -123,6 +124,7 @@ function PanelFrame({
   const onScreen = useOnScreen(ref);
   const visible = !panel.collapsed && onScreen && pageVisible;
   const drag = useRef<{ dx: number; dy: number } | null>(null);
+  useAvoidNode(ref, block.name, panel.floating, onUpdate);
 
   const onPointerDown = (e: React.PointerEvent<HTMLElement>): void => {
     if (!panel.floating || e.button !== 0) return;

@@ -31,6 +31,7 @@ import { StatusIcon, STATUS_LABEL, type Status } from "./status";
 const nodeTypes = { block: BlockNode };
 /** Fit the pipeline, but never so small that it cannot be read (pan for the rest). */
 const FIT = { padding: 0.08, minZoom: 0.5, maxZoom: 1.25 };
+import { ReadableZoom } from "./readable-zoom";
 const edgeTypes = { rate: RateEdge };
 
 export interface BlockTableProps {
@@ -340,6 +341,7 @@ function Table(props: BlockTableProps) {
           </Controls>
           <Panel position="top-right" className="graph-actions">
             <button type="button" onClick={autoLayout} title="Arrange the blocks automatically">
+          <ReadableZoom target={box} />
               Auto layout
             </button>
             <button

@@ -427,7 +427,8 @@ function drawHeatmap(
     }
     ctx.stroke();
   }
-  if (g.cell >= 26 && !layout.matrix) {
+  // Channel labels only where they can be 11 px or more (readable on screen).
+  if (g.cell >= 33 && !layout.matrix) {
     ctx.font = `${Math.min(13, Math.floor(g.cell / 3))}px system-ui, sans-serif`;
     ctx.textAlign = "center";
     ctx.textBaseline = "middle";
@@ -451,7 +452,7 @@ function drawHeatmap(
   ctx.strokeStyle = theme.grid;
   ctx.strokeRect(lx + 0.5, ly + 0.5, 12, lh);
   ctx.fillStyle = theme.fg;
-  ctx.font = "10px system-ui, sans-serif";
+  ctx.font = "11px system-ui, sans-serif";
   ctx.textAlign = "left";
   ctx.textBaseline = "middle";
   const ticks = niceTicks(lo, hi, 4);

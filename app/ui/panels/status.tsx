@@ -297,7 +297,7 @@ function drawHistory(
     prevX = x;
   });
   ctx.fillStyle = theme.muted;
-  ctx.font = "10px system-ui, sans-serif";
+  ctx.font = "11px system-ui, sans-serif";
   ctx.textBaseline = "middle";
   ctx.textAlign = "right";
   ctx.fillText("status", left - 4, STRIP_H / 2);
