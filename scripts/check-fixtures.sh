@@ -21,6 +21,7 @@ GENERATORS=(
   "core-wasm/learn/tests/fixtures/gen_learn.py:learn.json"
   "core-wasm/learn/tests/fixtures/gen_emg_regression.py:emg_regression.json"
   "core-wasm/learn/tests/fixtures/gen_lda.py:lda.json"
+  "templates/rust-block/tests/fixtures/gen_tkeo.py:tkeo.json"
   "app/blocks/signal/fixtures/gen_dds.py:dds.json"
   "app/blocks/signal/fixtures/gen_envelope.py:envelope_5hz.csv"
   "app/blocks/kinematics/fixtures/gen_body_rig.py:body_rig.json"

@@ -25,6 +25,10 @@ step "rust (fmt, clippy, tests)"
 cargo fmt --manifest-path core-wasm/Cargo.toml --all -- --check
 cargo clippy --quiet --manifest-path core-wasm/Cargo.toml --workspace --all-targets -- -D warnings
 cargo test --quiet --manifest-path core-wasm/Cargo.toml --workspace
+# The Rust block template (mosaic new-block --rust): its kernel, reference and ABI tests.
+cargo fmt --manifest-path templates/rust-block/Cargo.toml -- --check
+cargo clippy --quiet --manifest-path templates/rust-block/Cargo.toml --all-targets -- -D warnings
+cargo test --quiet --manifest-path templates/rust-block/Cargo.toml
 
 step "reference fixtures are reproduced by their committed generators"
 bash scripts/check-fixtures.sh
