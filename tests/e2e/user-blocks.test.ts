@@ -1,0 +1,122 @@
+/**
+ * A block written by a user (issue 18) in the UI that `mosaic serve` serves: the guide's
+ * (docs/writing-blocks.md) block and pipeline in a folder outside the repository; the page shows
+ * the user block's node running, lists its type in the editor's palette (with its help), and
+ * saving the block's file reloads it: the pipeline restarts and the Log says so; a save with a
+ * syntax error leaves the running version running and the Log names the file and line.
+ */
+import type { ChildProcess } from "node:child_process";
+import { mkdirSync, readFileSync, writeFileSync } from "node:fs";
+import { join } from "node:path";
+import { afterAll, beforeAll, describe, expect, test } from "vitest";
+import { requireBuild, startCli, tempDir } from "../integration/helpers";
+import {
+  artifact,
+  ensureWebBuild,
+  haveChromium,
+  launchChromium,
+  openApp,
+  ROOT,
+  type Chromium,
+} from "./harness";
+
+/** The guide's block and pipeline, written into `dir`. */
+function projectFromGuide(dir: string): void {
+  const md = readFileSync(join(ROOT, "docs/writing-blocks.md"), "utf8");
+  const code = [...md.matchAll(/```(\w+)\n([\s\S]*?)```/g)].map((m) => ({
+    lang: m[1]!,
+    text: m[2]!,
+  }));
+  mkdirSync(join(dir, "blocks"));
+  writeFileSync(
+    join(dir, "blocks/smoother.ts"),
+    code.find((c) => c.lang === "ts" && c.text.includes("defineBlock({"))!.text,
+  );
+  writeFileSync(
+    join(dir, "pipeline.yaml"),
+    code.find((c) => c.lang === "yaml" && c.text.includes("Blocks:"))!.text,
+  );
+}
+
+/** The text of the Log's entries (opened once). */
+async function logText(page: import("playwright-core").Page): Promise<string> {
+  if ((await page.$("#event-log-list")) === null) await page.click(".event-log__toggle");
+  await page.waitForSelector("#event-log-list");
+  return (await page.textContent("#event-log-list")) ?? "";
+}
+
+describe.skipIf(!haveChromium)("a user's block in mosaic serve's UI (Chromium)", () => {
+  let cli: ChildProcess;
+  let url: string;
+  let browser: Chromium;
+  let dir: string;
+
+  beforeAll(async () => {
+    ensureWebBuild();
+    requireBuild();
+    dir = tempDir("mosaic-e2e-user-blocks-");
+    projectFromGuide(dir);
+    cli = startCli(["serve", join(dir, "pipeline.yaml"), "--port", "0"]);
+    let out = "";
+    url = await new Promise<string>((resolve, reject) => {
+      const t = setTimeout(() => reject(new Error(`no URL printed: ${out}`)), 30_000);
+      const seen = (d: Buffer) => {
+        out += d.toString();
+        const m = /MOSAIC is at (\S+)/.exec(out);
+        if (m) {
+          clearTimeout(t);
+          resolve(m[1]!);
+        }
+      };
+      cli.stdout!.on("data", seen);
+      cli.stderr!.on("data", (d: Buffer) => (out += d.toString()));
+    });
+    browser = await launchChromium();
+  }, 60_000);
+
+  afterAll(async () => {
+    await browser?.close();
+    if (cli && cli.exitCode === null) {
+      cli.kill("SIGINT");
+      await new Promise((r) => cli.once("exit", r));
+    }
+  });
+
+  test("runs, is in the palette, and a saved file reloads it visibly", async () => {
+    const { page, errors, close } = await openApp(browser, url);
+    // The user block's node runs with the built-in ones.
+    await page.waitForSelector('[data-block="Smooth"][data-status="ontime"]', { timeout: 20_000 });
+    expect(await page.textContent('[data-block="Smooth"]')).toContain("Smoother");
+
+    // The editor's palette lists the type, with the guide's help and the file it came from.
+    await page.click('button:has-text("Edit")');
+    const item = page.locator('.palette__item[data-block-type="Smoother"]');
+    await item.waitFor({ timeout: 15_000 });
+    expect(await item.textContent()).toContain("Exponential smoothing of every channel");
+    await page.screenshot({ path: artifact("user-blocks-palette.png") });
+    await page.click('button:has-text("Edit")');
+
+    // Saving the block's file reloads it: the pipeline restarts and the Log says so.
+    const file = join(dir, "blocks/smoother.ts");
+    const good = readFileSync(file, "utf8");
+    writeFileSync(file, good.replace("near 0 it smooths a lot", "near 0 it smooths much"));
+    await expect
+      .poll(() => logText(page), { timeout: 20_000 })
+      .toContain("reloaded smoother.ts: pipeline restarted");
+    await page.waitForSelector('[data-block="Smooth"][data-status="ontime"]', { timeout: 20_000 });
+
+    // A save with a syntax error: the running version stays, the Log names the file and line.
+    writeFileSync(file, good.replace("const n = shape.rows", "const n = = shape.rows"));
+    await expect
+      .poll(() => logText(page), { timeout: 20_000 })
+      .toMatch(
+        /smoother\.ts changed but does not load, the previous version keeps running: cannot load user blocks from blocks\/smoother\.ts:\d+:\d+/,
+      );
+    await page.screenshot({ path: artifact("user-blocks-reload.png") });
+    expect(await page.getAttribute(".app", "data-engine-state")).toBe("running");
+    await page.waitForSelector('[data-block="Smooth"][data-status="ontime"]', { timeout: 20_000 });
+    writeFileSync(file, good);
+    expect(errors).toEqual([]);
+    await close();
+  }, 120_000);
+});
