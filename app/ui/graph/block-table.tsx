@@ -23,6 +23,8 @@ import { useCallback, useEffect, useMemo, useRef, useState } from "react";
 import type { GraphInfo } from "../../engine/protocol";
 import { BlockMenu } from "./block-menu";
 import { BlockNode, GraphStateContext, type BlockNodeType, type GraphState } from "./block-node";
+import { initialBoxes, rememberBoxes, type Boxes } from "./boxes";
+import { LargeFlowTools } from "./large-flow-tools";
 import { layeredLayout } from "./layout";
 import { updateLayout } from "./layout-yaml";
 import { EdgeMarkerDefs, RateEdge, type RateEdgeType } from "./rate-edge";
@@ -151,6 +153,16 @@ function Table(props: BlockTableProps) {
   );
   const focusBack = useRef<HTMLElement | null>(null);
   const byName = useMemo(() => new Map(graph.blocks.map((b) => [b.name, b])), [graph]);
+  const names = useMemo(() => graph.blocks.map((b) => b.name), [graph]);
+  // Group and comment boxes (Pipeline: { Layout }), kept across reloads as positions are.
+  const [boxes, setBoxesNow] = useState<Boxes>(() => initialBoxes(graph));
+  const setBoxes = useCallback(
+    (b: Boxes) => {
+      setBoxesNow(b);
+      rememberBoxes(graph, b);
+    },
+    [graph],
+  );
 
   const openMenu = useCallback((block: string, anchor: { x: number; y: number }) => {
     focusBack.current =
@@ -271,7 +283,7 @@ function Table(props: BlockTableProps) {
     if (source === undefined) return;
     try {
       const positions = new Map(nodes.map((n) => [n.id, n.position]));
-      const text = updateLayout(source, positions);
+      const text = updateLayout(source, positions, boxes);
       const name = graph.file.split("/").pop() || "pipeline.yaml";
       download(name, text);
       props.onNotify(`Saved the layout into ${name} (downloaded)`);
@@ -320,6 +332,15 @@ function Table(props: BlockTableProps) {
           aria-label="BlockTable: the pipeline's blocks and connections"
         >
           <Background gap={24} size={1.2} />
+          <LargeFlowTools
+            names={names}
+            boxes={boxes}
+            onBoxes={setBoxes}
+            onBlocksMoved={(moved) => {
+              for (const [id, p] of moved) remembered?.set(id, { ...p });
+            }}
+            duration={duration}
+          />
           <Controls showInteractive={false} showFitView={false} position="bottom-left">
             <ControlButton
               onClick={() => {

@@ -1,0 +1,79 @@
+/**
+ * What a large pipeline needs on the BlockTable (issue 17, "large flows"): a minimap (click or
+ * drag in it to move the view), finding a block by name (block-search.tsx), and group and comment
+ * boxes (box-layer.tsx) added here and saved into the file's `Pipeline: { Layout }` by
+ * "Save layout…". Rendered inside the BlockTable's <ReactFlow>.
+ */
+import { MiniMap, Panel, useReactFlow } from "@xyflow/react";
+import { BlockSearch } from "./block-search";
+import { BoxLayer, type BoxLayerProps } from "./box-layer";
+import { newBox, type BoxKind } from "./boxes";
+import "./graph-tools.css";
+
+export interface LargeFlowToolsProps extends BoxLayerProps {
+  names: readonly string[];
+  /** Animation of view changes, ms (0 with reduced motion). */
+  duration: number;
+}
+
+function Minimap({ duration }: { duration: number }) {
+  const flow = useReactFlow();
+  return (
+    <MiniMap
+      className="graph-minimap"
+      position="bottom-left"
+      pannable
+      zoomable
+      ariaLabel="Minimap of the pipeline: click or drag to move the view"
+      nodeStrokeWidth={3}
+      onClick={(_e, p) => void flow.setCenter(p.x, p.y, { zoom: flow.getZoom(), duration })}
+    />
+  );
+}
+
+function AddBoxes({ layer }: { layer: BoxLayerProps }) {
+  const flow = useReactFlow();
+  const add = (kind: BoxKind, e: React.MouseEvent<HTMLButtonElement>): void => {
+    const graph = e.currentTarget.closest(".block-table")?.getBoundingClientRect();
+    const at = graph
+      ? flow.screenToFlowPosition({ x: graph.x + graph.width / 2, y: graph.y + graph.height / 2 })
+      : { x: 0, y: 0 };
+    const box = newBox(kind, at);
+    const { boxes } = layer;
+    layer.onBoxes(
+      kind === "group"
+        ? {
+            ...boxes,
+            groups: [...boxes.groups, { title: `Group ${boxes.groups.length + 1}`, ...box }],
+          }
+        : { ...boxes, comments: [...boxes.comments, { text: "Comment", ...box }] },
+    );
+  };
+  return (
+    <>
+      <button
+        type="button"
+        onClick={(e) => add("group", e)}
+        title="A titled box: the blocks inside it move with it"
+      >
+        + Group
+      </button>
+      <button type="button" onClick={(e) => add("comment", e)} title="A box of text on the canvas">
+        + Comment
+      </button>
+    </>
+  );
+}
+
+export function LargeFlowTools(props: LargeFlowToolsProps) {
+  return (
+    <>
+      <Panel position="top-left" className="graph-tools">
+        <BlockSearch names={props.names} duration={props.duration} />
+        <AddBoxes layer={props} />
+      </Panel>
+      <Minimap duration={props.duration} />
+      <BoxLayer boxes={props.boxes} onBoxes={props.onBoxes} onBlocksMoved={props.onBlocksMoved} />
+    </>
+  );
+}
