@@ -54,6 +54,13 @@ describe("editor model", () => {
     });
   });
 
+  test("the settings entry Pipeline: { … } is not a block; a block named Pipeline is", () => {
+    const settings = "T: { Type: Tick }\nPipeline:\n  Layout:\n    Groups: []\n";
+    expect(readBlocks(settings).blocks.map((b) => b.name)).toEqual(["T"]);
+    const block = "T: { Type: Tick }\nPipeline: { Type: Drain, Inputs: [T] }\n";
+    expect(readBlocks(block).blocks.map((b) => b.name)).toEqual(["T", "Pipeline"]);
+  });
+
   test("YAML errors are positioned; an empty text has no blocks", () => {
     expect(readBlocks("").blocks).toEqual([]);
     const r = readBlocks("T: { Type: Tick\n");

@@ -62,6 +62,10 @@ function parseInput(s: string): EditInput {
 const isRecord = (v: unknown): v is Record<string, unknown> =>
   v !== null && typeof v === "object" && !Array.isArray(v);
 
+/** `Pipeline: { … }` without a Type is the pipeline's settings, not a block (keys.ts). */
+const isSettings = (name: string, value: unknown): boolean =>
+  name === "Pipeline" && isMap(value) && !value.items.some((p) => keyOf(p) === "Type");
+
 /** The blocks of a pipeline's text, in file order. */
 export function readBlocks(text: string): ReadResult {
   const lc = new LineCounter();
@@ -94,7 +98,7 @@ export function readBlocks(text: string): ReadResult {
   const blocks: EditBlock[] = [];
   for (const pair of root.items) {
     const name = keyOf(pair);
-    if (typeof name !== "string") continue;
+    if (typeof name !== "string" || isSettings(name, pair.value)) continue;
     const start = (pair.key as { range?: [number, number, number] } | null)?.range?.[0];
     const line = start !== undefined ? lc.linePos(start).line : 0;
     const v = (pair.value as { toJSON?(): unknown } | null)?.toJSON?.() ?? null;
