@@ -156,4 +156,43 @@ describe.skipIf(!haveChromium)("readable text (Chromium)", () => {
       }, 90_000);
     }
   }
+
+  test("presentation mode: larger type everywhere, graph text at least 15 px, remembered", async () => {
+    const app = await openApp(chromium, served.url, "pipelines/demo.yaml");
+    const { page } = app;
+    await page.setViewportSize(SIZES[0]!);
+    await page.click('.block-node[data-block="Emg"]');
+    await graphSettled(page);
+    const before = await seenText(page);
+    const toggle = page.locator(".toolbar button.presentation-toggle");
+    expect(await toggle.getAttribute("aria-pressed")).toBe("false");
+    await toggle.click();
+    await page.waitForSelector('html[data-presentation="true"]');
+    await graphSettled(page);
+    const after = await seenText(page);
+    await page.screenshot({ path: artifact("readable-presentation-1280x720.png") });
+    const size = (seen: typeof before, part: string, text: string): number =>
+      seen.find((s) => s.where.includes(part) && s.text === text)?.px ?? NaN;
+    // The chrome is 1.25× (the Load button, the panel's title), the graph at least 15 px.
+    expect(size(after, "button", "Load")).toBeCloseTo(size(before, "button", "Load") * 1.25, 1);
+    expect(size(after, "panel-frame__title", "Emg")).toBeCloseTo(
+      size(before, "panel-frame__title", "Emg") * 1.25,
+      1,
+    );
+    const graph = after.filter((s) => /block-node|rate-edge/.test(s.where));
+    expect(graph.length).toBeGreaterThan(5);
+    expect(tooSmall(graph, 14.9)).toEqual([]);
+    expect(tooSmall(after, MIN_PX)).toEqual([]);
+    // Remembered: a new page starts in presentation mode; switched off, it stays off.
+    const again = await openApp(chromium, served.url, "pipelines/demo.yaml");
+    await again.page.waitForSelector('html[data-presentation="true"]');
+    await again.page.click(".toolbar button.presentation-toggle");
+    await again.page.waitForSelector('html[data-presentation="false"]');
+    await again.close();
+    const third = await openApp(chromium, served.url, "pipelines/demo.yaml");
+    expect(await third.page.getAttribute("html", "data-presentation")).toBe("false");
+    await third.close();
+    expect(app.errors).toEqual([]);
+    await app.close();
+  }, 90_000);
 });
