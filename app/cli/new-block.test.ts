@@ -43,6 +43,16 @@ describe("mosaic new-block --rust", () => {
     for (const f of ["src/abi.rs", "src/tkeo.rs", "src/lib.rs", "tests/fixtures/tkeo.json"]) {
       expect(read(f)).toBe(readFileSync(join(rustTemplateDir(), f), "utf8"));
     }
+    // The editor's type checker finds mosaic/sdk in this MOSAIC's sources.
+    const tsconfig = JSON.parse(read("tsconfig.json")) as {
+      compilerOptions: { paths: Record<string, string[]>; strict: boolean };
+      include: string[];
+    };
+    const sdk = join(rustTemplateDir(), "..", "..", "app", "engine", "sdk.ts");
+    expect(tsconfig.compilerOptions.paths["mosaic/sdk"]).toEqual([sdk]);
+    expect(existsSync(sdk)).toBe(true);
+    expect(tsconfig.compilerOptions.strict).toBe(true);
+    expect(tsconfig.include).toEqual(["block.ts", "wasm.d.ts"]);
     expect(existsSync(join(r.dir, "target"))).toBe(false);
     expect(existsSync(join(r.dir, "Cargo.lock"))).toBe(false);
   });

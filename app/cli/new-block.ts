@@ -14,8 +14,8 @@ export function newBlockHelp(): string {
   return `  mosaic new-block --rust NAME [DIR]
       Creates a block written in Rust in DIR/NAME (DIR: the current folder by default): a
       crate whose kernel (src/tkeo.rs, the Teager–Kaiser energy operator as an example) builds
-      to a WebAssembly module, and block.ts, the block MOSAIC loads (type name: NAME in
-      PascalCase). NAME: lower case letters, digits, '-' and '_', starting with a letter.
+      to a WebAssembly module, block.ts, the block MOSAIC loads (type name: NAME in
+      PascalCase), and a tsconfig.json for editors (mosaic/sdk: this MOSAIC's SDK). NAME: lower case letters, digits, '-' and '_', starting with a letter.
       Prints the build command and how to use it in a pipeline (docs/writing-blocks.md).`;
 }
 
@@ -94,7 +94,31 @@ export function createRustBlock(
     }
     writeFileSync(path, text.replaceAll(r.from, r.to));
   }
+  writeEditorConfig(dir, template);
   return { dir, type, libName };
+}
+
+/**
+ * tsconfig.json for the user's editor and `npx tsc -p .`: `mosaic/sdk` is this MOSAIC's SDK
+ * source (docs/writing-blocks.md, "Types in your editor"); MOSAIC itself needs no build step.
+ */
+function writeEditorConfig(dir: string, template: string): void {
+  const sdk = join(dirname(dirname(template)), "app", "engine", "sdk.ts");
+  if (!existsSync(sdk)) return;
+  const config = {
+    compilerOptions: {
+      strict: true,
+      target: "es2022",
+      module: "esnext",
+      moduleResolution: "bundler",
+      noEmit: true,
+      skipLibCheck: true,
+      types: [],
+      paths: { "mosaic/sdk": [sdk] },
+    },
+    include: ["block.ts", "wasm.d.ts"],
+  };
+  writeFileSync(join(dir, "tsconfig.json"), `${JSON.stringify(config, null, 2)}\n`);
 }
 
 /** `path` as the user may type it from `cwd`: relative below it, else absolute. */

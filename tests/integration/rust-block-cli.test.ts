@@ -1,10 +1,11 @@
 /**
  * Issue 18's acceptance for Rust blocks, exactly as docs/writing-blocks.md ("Rust blocks") says
  * it, in a temporary folder outside the repository: `mosaic new-block --rust tkeo DIR`, the cargo
- * build it prints, a pipeline naming `tkeo/block.ts`, `mosaic test-block`, `mosaic validate` and
- * a headless `mosaic run` whose log is checked against the operator's closed form for a sine
- * (ψ = A²·sin²(2πf/rate)). Then the module rebuilt with another ABI version: the pipeline does not
- * load, and the message names the module and both versions.
+ * build it prints, `tsc -p .` with the tsconfig.json it wrote, a pipeline naming
+ * `tkeo/block.ts`, `mosaic test-block`, `mosaic validate` and a headless `mosaic run` whose log is
+ * checked against the operator's closed form for a sine (ψ = A²·sin²(2πf/rate)). Then the module
+ * rebuilt with another ABI version: the pipeline does not load, and the message names the module
+ * and both versions.
  */
 import { spawnSync } from "node:child_process";
 import { readFileSync, rmSync, writeFileSync } from "node:fs";
@@ -57,6 +58,19 @@ describe("a Rust block made with the documented commands, outside the repository
 
     cargoBuild(join(dir, "tkeo"));
     writeFileSync(join(dir, "pipeline.yaml"), PIPELINE);
+
+    // block.ts type-checks against the SDK with the tsconfig.json new-block wrote (strict).
+    const tsc = spawnSync(
+      process.execPath,
+      [join(ROOT, "node_modules", "typescript", "bin", "tsc"), "-p", "."],
+      {
+        cwd: join(dir, "tkeo"),
+        encoding: "utf8",
+        timeout: 240_000,
+      },
+    );
+    expect(tsc.stdout + tsc.stderr).toBe("");
+    expect(tsc.status).toBe(0);
 
     const tested = runCli(["test-block", "tkeo/block.ts"], { cwd: dir, timeoutMs: 120_000 });
     expect(tested.stdout).toContain("Tkeo: all 6 checks pass");
