@@ -16,6 +16,10 @@ import * as prettier from "prettier";
 import { z } from "zod";
 import { BLOCKS } from "../app/blocks/catalog";
 import { outputNames, type AnyBlockDefinition, type BlockCategory } from "../app/engine/block";
+import { catalogTypes, createCatalog } from "../app/engine/catalog";
+import { formatDiagnostic } from "../app/engine/diagnostics";
+import { pipelineCatalog } from "../app/engine/user-blocks";
+import { loadBlockModule } from "../app/host/user-blocks";
 import { MAX_LAYOUT_BOXES, MAX_LAYOUT_TEXT } from "../app/engine/pipeline/pipeline-layout";
 
 /** Output paths, repo-relative. */
@@ -538,7 +542,40 @@ export async function renderFiles(
   };
 }
 
+/**
+ * `--pipeline FILE`: the reference and the JSON Schema of one pipeline's blocks — the built-in
+ * ones and those of its `Pipeline: { Blocks }` modules (docs/writing-blocks.md) — written beside
+ * it as blocks.md and pipeline.schema.json.
+ */
+async function pipelineDocs(file: string): Promise<void> {
+  const source = readFileSync(file, "utf8");
+  const own = await pipelineCatalog(source, resolve(file), createCatalog(BLOCKS), loadBlockModule);
+  for (const d of own.diagnostics) console.error(formatDiagnostic(d));
+  if (own.diagnostics.some((d) => d.severity === "error")) {
+    process.exitCode = 2;
+    return;
+  }
+  const blocks = catalogTypes(own.catalog);
+  const { markdown: md, schema } = generateDocs(blocks);
+  const dir = dirname(resolve(file));
+  const out: [string, string][] = [
+    [join(dir, "blocks.md"), await prettier.format(md, { parser: "markdown" })],
+    [
+      join(dir, "pipeline.schema.json"),
+      await prettier.format(JSON.stringify(schema, null, 2), { parser: "json" }),
+    ],
+  ];
+  for (const [path, text] of out) {
+    await writeFile(path, text);
+    console.log(
+      `gen-docs: wrote ${path} (${blocks.length} block types, ${blocks.length - BLOCKS.length} of the pipeline's own)`,
+    );
+  }
+}
+
 export async function main(): Promise<void> {
+  const at = process.argv.indexOf("--pipeline");
+  if (at >= 0) return pipelineDocs(process.argv[at + 1] ?? "");
   const root = repoRoot();
   const files = await renderFiles(BLOCKS, root);
   for (const [rel, text] of Object.entries(files)) {

@@ -104,6 +104,29 @@ describe("a TypeScript block made from docs/writing-blocks.md", () => {
       expect(Math.abs(v! - y)).toBeLessThan(1e-12);
     });
   }, 60_000);
+
+  test("the guide's gen-docs --pipeline writes the pipeline's reference and JSON Schema", () => {
+    execFileSync(
+      process.execPath,
+      [join(ROOT, "dist/tools/gen-docs.mjs"), "--pipeline", "pipeline.yaml"],
+      {
+        cwd: dir,
+        encoding: "utf8",
+      },
+    );
+    const md = readFileSync(join(dir, "blocks.md"), "utf8");
+    expect(md).toMatch(/### Smoother\n\n\*\*Exponential smoothing of every channel/);
+    expect(md).toContain("(User block from blocks/smoother.ts.)");
+    const schema = JSON.parse(readFileSync(join(dir, "pipeline.schema.json"), "utf8")) as {
+      definitions: Record<
+        string,
+        { properties: Record<string, { enum?: string[]; maximum?: number }> }
+      >;
+    };
+    expect(schema.definitions.Block!.properties.Type!.enum).toContain("Smoother");
+    expect(schema.definitions.Block!.properties.Type!.enum).toContain("Filter");
+    expect(schema.definitions["Smoother.Params"]!.properties.Alpha!.maximum).toBe(1);
+  }, 60_000);
 });
 
 const BROKEN = `import { defineBlock, z } from "mosaic/sdk";
