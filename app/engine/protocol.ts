@@ -97,6 +97,20 @@ export const uiMessageSchema = z.discriminatedUnion("type", [
   }),
   /** Finishes the session recording (a download in the browser build). */
   z.strictObject({ type: z.literal("record-stop"), id }),
+  /**
+   * The UI wrote live values back into the pipeline's text (`source`, comments kept): those
+   * values become the file's, so their "changed since loaded" markers clear in every client.
+   */
+  z.strictObject({
+    type: z.literal("params-written"),
+    id,
+    source: z.string().max(4_000_000),
+    values: z
+      .array(
+        z.strictObject({ block: z.string().min(1), param: z.string().min(1), value: z.unknown() }),
+      )
+      .max(100_000),
+  }),
 ]);
 
 export type UiMessage = z.infer<typeof uiMessageSchema>;
@@ -158,8 +172,13 @@ export interface BlockInfo {
   panel: string;
   /** Params that can be changed while running. */
   live: string[];
-  /** Current (validated) params. */
+  /** Current (validated) params: the engine's, live changes from any client included. */
   params: Record<string, unknown>;
+  /**
+   * The live params' values in the file (as loaded, or as last written back): a live param whose
+   * current value differs was changed since the pipeline was loaded.
+   */
+  fileParams?: Record<string, unknown>;
   /** JSON Schema (draft 2020-12, input side) of the params: the UI builds its form from it. */
   paramsSchema: unknown;
   actions: ActionInfo[];
@@ -201,6 +220,15 @@ export interface GraphInfo {
   layout?: PipelineLayout;
   /** True when the pipeline was loaded with simulated devices. */
   simulateDevices?: boolean;
+  /** The pipeline's text as loaded (or as last written back: `params-written`). */
+  source?: string;
+}
+
+/** One block's live params now and in the file (a `params` message). */
+export interface BlockParamsInfo {
+  name: string;
+  params: Record<string, unknown>;
+  fileParams: Record<string, unknown>;
 }
 
 export type EngineState = "empty" | "loaded" | "running" | "stopped" | "finished";
@@ -269,6 +297,11 @@ export type EngineMessage =
   | { type: "telemetry"; telemetry: Telemetry }
   | { type: "event"; event: RuntimeEvent }
   | { type: "recording"; recording: RecordingStatus }
+  /**
+   * Live params changed (a `setParam` from any client) or were written back to the file
+   * (`params-written`: then with the file's new text): sent to every client.
+   */
+  | { type: "params"; blocks: BlockParamsInfo[]; source?: string }
   /**
    * A file for the page to save (browser build, where the engine cannot write files): a finished
    * session recording, a Buffer's or a model's save. Sent only to the page that runs the engine.

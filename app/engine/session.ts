@@ -17,6 +17,7 @@ import {
   parseUiMessage,
   unsupportedHello,
   type BlockInfo,
+  type BlockParamsInfo,
   type CatalogInfo,
   type DataMessage,
   type EngineMessage,
@@ -242,6 +243,10 @@ export class EngineSession {
   private file = "";
   /** The loaded pipeline runs with simulated devices. */
   private simulated = false;
+  /** The pipeline's text as loaded or last written back (`params-written`). */
+  private source = "";
+  /** Each block's live params as the file has them (the "changed since loaded" reference). */
+  private fileParams = new Map<string, Record<string, unknown>>();
   private readonly watches = new Map<string, Watch>();
   /** The load in progress (loads go one after another). */
   private loading: Promise<unknown> = Promise.resolve();
@@ -345,9 +350,15 @@ export class EngineSession {
         return;
       case "setParam": {
         const rt = this.requireRuntime();
-        this.reply(msg.id, true, rt.setParam(msg.block, msg.param, msg.value));
+        const said = rt.setParam(msg.block, msg.param, msg.value);
+        // Every client shows the engine's value (issue 17, defect 1).
+        this.platform.post({ type: "params", blocks: [this.blockParams(msg.block)] });
+        this.reply(msg.id, true, said);
         return;
       }
+      case "params-written":
+        this.reply(msg.id, true, this.paramsWritten(msg));
+        return;
       case "invoke": {
         const rt = this.requireRuntime();
         const m = rt.invoke(msg.block, msg.action, msg.arg);
@@ -449,6 +460,8 @@ export class EngineSession {
     }
     this.rt = created.runtime;
     this.spec = loaded.spec;
+    this.source = source;
+    this.fileParams = this.liveParamsNow();
     this.setState("loaded");
     return { diagnostics, graph: this.graph() };
   }
@@ -611,6 +624,7 @@ export class EngineSession {
         panel: b.def.panel ?? "",
         live: [...(b.def.live ?? [])],
         params: (node.params ?? {}) as Record<string, unknown>,
+        fileParams: this.fileParams.get(b.name) ?? {},
         paramsSchema: schema,
         actions: [...own, ...BUILT_IN_ACTIONS],
         ...(b.layout ? { layout: b.layout } : {}),
@@ -620,9 +634,58 @@ export class EngineSession {
     return {
       file: this.file,
       blocks,
+      source: this.source,
       ...(this.simulated ? { simulateDevices: true } : {}),
       ...(this.spec!.settings.layout ? { layout: this.spec!.settings.layout } : {}),
     };
+  }
+
+  /** Each block's live params as they are now (those it has: a block may have none). */
+  private liveParamsNow(): Map<string, Record<string, unknown>> {
+    const out = new Map<string, Record<string, unknown>>();
+    for (const b of this.spec?.blocks ?? []) {
+      const params = (this.rt?.node(b.name)?.params ?? {}) as Record<string, unknown>;
+      const live: Record<string, unknown> = {};
+      for (const p of b.def.live ?? []) if (p in params) live[p] = params[p];
+      out.set(b.name, live);
+    }
+    return out;
+  }
+
+  private blockParams(name: string): BlockParamsInfo {
+    const node = this.requireRuntime().node(name);
+    if (!node) throw new Error(`no block '${name}'`);
+    return {
+      name,
+      params: (node.params ?? {}) as Record<string, unknown>,
+      fileParams: this.fileParams.get(name) ?? {},
+    };
+  }
+
+  /**
+   * The UI wrote live values into the pipeline's text: they are the file's from now on (each
+   * validated as `setParam` would; a block or param that is not live here is refused).
+   */
+  private paramsWritten(msg: Extract<UiMessage, { type: "params-written" }>): string {
+    const rt = this.requireRuntime();
+    const next = new Map([...this.fileParams].map(([k, v]) => [k, { ...v }]));
+    for (const { block, param, value } of msg.values) {
+      const node = rt.node(block);
+      if (!node) throw new Error(`no block '${block}'`);
+      if (!(node.def.live ?? []).includes(param))
+        throw new Error(`param '${param}' of '${block}' is not live`);
+      const r = node.def.params.safeParse({ ...(node.params as object), [param]: value });
+      if (!r.success) throw new Error(`invalid value for '${block}.${param}'`);
+      const file = next.get(block) ?? {};
+      file[param] = (r.data as Record<string, unknown>)[param];
+      next.set(block, file);
+    }
+    this.fileParams = next;
+    this.source = msg.source;
+    const blocks = [...new Set(msg.values.map((v) => v.block))].map((b) => this.blockParams(b));
+    this.platform.post({ type: "params", blocks, source: msg.source });
+    const n = msg.values.length;
+    return `${n} live value${n === 1 ? "" : "s"} written to ${this.file}`;
   }
 
   private start(): void {
@@ -737,6 +800,7 @@ export class EngineSession {
     this.rt?.dispose();
     this.rt = undefined;
     this.spec = undefined;
+    this.fileParams = new Map();
   }
 
   dispose(): void {

@@ -95,6 +95,22 @@ export function defaultAllowedDirs(pipelinesDir: string, dataDir?: string): stri
   return [join(pipelinesDir, "pipelines"), ...(dataDir !== undefined ? [dataDir] : [])];
 }
 
+/** `graph` with a `params` message's current and file values (and the file's new text). */
+export function withParams(
+  graph: GraphInfo,
+  m: Extract<EngineMessage, { type: "params" }>,
+): GraphInfo {
+  const by = new Map(m.blocks.map((b) => [b.name, b]));
+  return {
+    ...graph,
+    ...(m.source !== undefined ? { source: m.source } : {}),
+    blocks: graph.blocks.map((b) => {
+      const p = by.get(b.name);
+      return p ? { ...b, params: p.params, fileParams: p.fileParams } : b;
+    }),
+  };
+}
+
 export function defaultSessionWorkerPath(): string {
   const here = dirname(fileURLToPath(import.meta.url));
   for (const p of [
@@ -277,6 +293,11 @@ export class SessionHub {
       case "telemetry":
       case "event":
       case "recording":
+        this.broadcast(m);
+        return;
+      case "params":
+        // A client that joins later gets the engine's values with the graph.
+        if (this.graph) this.graph = withParams(this.graph, m);
         this.broadcast(m);
         return;
       case "graph":

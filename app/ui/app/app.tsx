@@ -26,6 +26,7 @@ import { UiContext, type UiActions } from "./ui-context";
 import { usePipeline, type PipelineEntry } from "./use-pipeline";
 import { useEventLog } from "./use-event-log";
 
+import { useWriteLiveValues } from "./use-live-values";
 const STATE_LABEL: Record<EngineState, string> = {
   empty: "no pipeline",
   loaded: "loaded",
@@ -174,6 +175,14 @@ function Shell({
   });
   const [stimulus, setStimulus] = useState<string | null>(null);
 
+  const writeLiveValues = useWriteLiveValues(
+    client,
+    () =>
+      pipeline.file !== undefined && pipeline.source !== undefined
+        ? { file: pipeline.file, source: pipeline.source }
+        : undefined,
+    notify,
+  );
   const ui = useMemo<UiActions>(
     () => ({
       togglePanel: (name) =>
@@ -192,7 +201,8 @@ function Shell({
       openStimulus: (name) => setStimulus(name),
       notify,
     }),
-    [notify],
+      writeLiveValues,
+    [notify, writeLiveValues],
   );
 
   // A new load keeps the panels of blocks that are still there (same name and type).

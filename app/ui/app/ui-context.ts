@@ -12,6 +12,8 @@ export interface UiActions {
   openStimulus(block: string): void;
   /** A line in the event log (and a short notice), e.g. the reply of an action. */
   notify(message: string, level?: "info" | "error", block?: string): void;
+  /** Writes the live values that are not the file's back into it (issue 17, defect 1). */
+  writeLiveValues?(): void;
 }
 
 const noop = (): void => {};

@@ -143,7 +143,8 @@ export function usePipeline(client: EngineClient, initial: string, simulateDevic
         loading: false,
         file: graph.file,
         selected: graph.file,
-        source: undefined,
+        // The engine's copy of the text (Save layout, edit mode, writing live values back).
+        source: graph.source,
         graph,
         generation: p.generation + 1,
         diagnostics: [],
@@ -157,6 +158,14 @@ export function usePipeline(client: EngineClient, initial: string, simulateDevic
 
   // Another client of a shared engine (a tab, the desktop menu) loaded a pipeline: show it.
   useEffect(() => client.onRemoteGraph(adopt), [client, adopt]);
+  // A client wrote the live values back: the pipeline's text is the new one.
+  useEffect(
+    () =>
+      client.onParams((_blocks, source) => {
+        if (source !== undefined) setS((p) => (p.graph === client.graph ? { ...p, source } : p));
+      }),
+    [client],
+  );
 
   return {
     ...s,

@@ -4,6 +4,7 @@
  * Framework-free; React components use it through the hooks in ./hooks.ts.
  */
 import type {
+  BlockParamsInfo,
   CatalogInfo,
   DataMessage,
   EngineConnection,
@@ -52,6 +53,9 @@ export class EngineClient {
   private readonly remoteGraphListeners = new Set<(g: GraphInfo) => void>();
   private readonly recordingListeners = new Set<(r: RecordingStatus) => void>();
   private readonly downloadListeners = new Set<(d: DownloadFile) => void>();
+  private readonly paramsListeners = new Set<
+    (blocks: BlockParamsInfo[], source?: string) => void
+  >();
   private readonly off: () => void;
   telemetry: Telemetry | undefined;
   state: EngineState = "empty";
@@ -109,6 +113,9 @@ export class EngineClient {
       case "download":
         for (const l of this.downloadListeners) l(m);
         break;
+      case "params":
+        this.applyParams(m.blocks, m.source);
+        break;
     }
   }
 
@@ -153,12 +160,46 @@ export class EngineClient {
     return this.request({ type: "stop" });
   }
 
-  /** Sets a live param; on success the param is also updated in `graph` (what panels show). */
-  async setParam(block: string, param: string, value: unknown): Promise<Reply> {
-    const r = await this.request({ type: "setParam", block, param, value });
-    const info = r.ok ? this.graph?.blocks.find((b) => b.name === block) : undefined;
-    if (info) info.params = { ...info.params, [param]: value };
-    return r;
+  /**
+   * Sets a live param. The engine answers every client with the block's params (a `params`
+   * message, before this reply): `graph` then holds the engine's values.
+   */
+  setParam(block: string, param: string, value: unknown): Promise<Reply> {
+    return this.request({ type: "setParam", block, param, value });
+  }
+
+  /**
+   * Tells the engine that the pipeline's text is now `source`, with these live values written
+   * into it: their "changed since loaded" markers clear in every client.
+   */
+  paramsWritten(
+    source: string,
+    values: { block: string; param: string; value: unknown }[],
+  ): Promise<Reply> {
+    return this.request({ type: "params-written", source, values });
+  }
+
+  /**
+   * The engine's live params changed (any client) or were written to the file: `graph`'s blocks
+   * get the new values (new objects, so that React sees them), then the listeners are told.
+   */
+  private applyParams(blocks: BlockParamsInfo[], source: string | undefined): void {
+    const g = this.graph;
+    if (g) {
+      const by = new Map(blocks.map((b) => [b.name, b]));
+      g.blocks = g.blocks.map((b) => {
+        const p = by.get(b.name);
+        return p ? { ...b, params: p.params, fileParams: p.fileParams } : b;
+      });
+      if (source !== undefined) g.source = source;
+    }
+    for (const l of this.paramsListeners) l(blocks, source);
+  }
+
+  /** Live params changed or were written back (see applyParams); `graph` is up to date then. */
+  onParams(l: (blocks: BlockParamsInfo[], source?: string) => void): () => void {
+    this.paramsListeners.add(l);
+    return () => this.paramsListeners.delete(l);
   }
 
   invoke(block: string, action: string, arg?: unknown): Promise<Reply> {

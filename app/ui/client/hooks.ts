@@ -8,7 +8,7 @@ import {
   useState,
   useSyncExternalStore,
 } from "react";
-import type { DataMessage, EngineState, GraphInfo } from "../../engine/protocol";
+import type { BlockInfo, DataMessage, EngineState, GraphInfo } from "../../engine/protocol";
 import type { Telemetry } from "../../engine/runtime/runtime";
 import type { EngineClient } from "./engine-client";
 
@@ -73,6 +73,28 @@ export function useGraph(): GraphInfo | undefined {
   const [g, setG] = useState(client.graph);
   useEffect(() => client.onGraph(setG), [client]);
   return g;
+}
+
+/**
+ * `block` as the engine has it now: its live params changed from any client, and the file's
+ * values they are compared with (issue 17, defect 1). Re-renders when a `params` message names
+ * the block. `block` itself while the engine's graph has no block of that name and type.
+ */
+export function useLiveBlock<B extends BlockInfo | undefined>(block: B): B {
+  const client = useEngine();
+  const getSnapshot = useCallback((): B => {
+    if (block === undefined) return block;
+    const now = client.graph?.blocks.find((b) => b.name === block.name);
+    return (now !== undefined && now.type === block.type ? now : block) as B;
+  }, [client, block]);
+  const subscribe = useCallback(
+    (cb: () => void) =>
+      client.onParams((blocks) => {
+        if (block !== undefined && blocks.some((b) => b.name === block.name)) cb();
+      }),
+    [client, block],
+  );
+  return useSyncExternalStore(subscribe, getSnapshot, getSnapshot);
 }
 
 /**

@@ -5,9 +5,13 @@
  * engine's reply is shown next to the field, a rejection included. Invalid input is shown next to
  * the field and never sent. Other params are fixed once the pipeline is instantiated: read-only,
  * with a hint (or editable through `onEditStatic` while not running, when the host offers it).
+ * The values shown are the engine's (`block.params`, kept current by the caller); a live param
+ * whose value is not the file's (`block.fileParams`) is marked "changed since loaded", and the
+ * form offers to write the live values back to the file (`onWriteBack`).
  */
 import { useEffect, useId, useMemo, useRef, useState, type ReactNode } from "react";
 import type { BlockInfo, EngineState } from "../../engine/protocol";
+import { changedParams } from "../editor/live-values";
 import { FieldEditor, isOneLine } from "./field-editors";
 import {
   deepEqual,
@@ -37,6 +41,8 @@ export interface ParamsFormProps {
    * edits the pipeline file and reloads it). Without it such params are read-only.
    */
   onEditStatic?: (param: string, value: unknown) => Promise<SetResult>;
+  /** Writes every live value that is not the file's back into the file (the shell's action). */
+  onWriteBack?: () => void;
 }
 
 export function ParamsForm({
@@ -44,6 +50,7 @@ export function ParamsForm({
   engineState,
   onSet,
   onEditStatic,
+  onWriteBack,
 }: ParamsFormProps): ReactNode {
   const root = (block.paramsSchema ?? {}) as JsonSchema;
   const form = useMemo(() => describeParams(root), [root]);
@@ -56,13 +63,15 @@ export function ParamsForm({
   const liveFields = form.fields.filter((f) => live.has(f.name));
   const fixedFields = form.fields.filter((f) => !live.has(f.name));
   const staticEditable = !running && loaded && onEditStatic !== undefined;
+  const changed = new Set(changedParams(block));
   const row = (f: Field, isLive: boolean): ReactNode => (
     <ParamRow
       key={`${block.name}.${f.name}`}
-      block={block}
       field={f}
       root={root}
       initial={block.params[f.name]}
+      changed={changed.has(f.name)}
+      fileValue={block.fileParams?.[f.name]}
       live={isLive}
       editable={isLive ? loaded : staticEditable}
       running={running}
@@ -74,7 +83,9 @@ export function ParamsForm({
       className="mf-form"
       onSubmit={(e) => e.preventDefault()}
       aria-label={`${block.name} params`}
+      data-changed={changed.size}
     >
+      {changed.size > 0 && <ChangedNote count={changed.size} onWriteBack={onWriteBack} />}
       {liveFields.length > 0 && (
         <section className="mf-group" aria-label="live params">
           <h4 className="mf-group-title">
@@ -109,11 +120,35 @@ type Reply =
   | { kind: "ok"; message: string }
   | { kind: "error"; message: string };
 
+/** The block's "changed since loaded" line, with the write-back action when offered. */
+function ChangedNote({
+  count,
+  onWriteBack,
+}: {
+  count: number;
+  onWriteBack: (() => void) | undefined;
+}): ReactNode {
+  return (
+    <p className="mf-changed-note" role="note">
+      <span className="mf-badge mf-badge-changed">changed since loaded</span>{" "}
+      {count === 1 ? "1 live value differs" : `${count} live values differ`} from the file.{" "}
+      {onWriteBack && (
+        <button type="button" className="mf-link" onClick={onWriteBack}>
+          Write live values back to the file
+        </button>
+      )}
+    </p>
+  );
+}
+
 interface RowProps {
-  block: BlockInfo;
   field: Field;
   root: JsonSchema;
+  /** The engine's value. */
   initial: unknown;
+  /** A live value other than the file's (`fileValue`). */
+  changed: boolean;
+  fileValue: unknown;
   live: boolean;
   editable: boolean;
   running: boolean;
@@ -121,10 +156,11 @@ interface RowProps {
 }
 
 function ParamRow({
-  block,
   field,
   root,
   initial,
+  changed,
+  fileValue,
   live,
   editable,
   running,
@@ -142,12 +178,16 @@ function ParamRow({
       mounted.current = false;
     };
   }, []);
-  // A new graph (reload) brings new current values.
+  // The engine's value changed (another client, a reload): shown at once, unless being edited.
+  const shownInitial = useRef(initial);
   useEffect(() => {
+    const before = shownInitial.current;
+    shownInitial.current = initial;
+    if (deepEqual(before, initial)) return;
     setCurrent(initial);
-    setDraft(initial);
-    setReply({ kind: "idle" });
-  }, [initial, block]);
+    setDraft((d: unknown) => (deepEqual(d, before) ? initial : d));
+    setReply((r) => (r.kind === "pending" ? r : { kind: "idle" }));
+  }, [initial]);
 
   const issues = useMemo(() => {
     const is: Issue[] = validate(field.schema, draft, root);
@@ -191,6 +231,7 @@ function ParamRow({
       className={`mf-param${live ? " mf-live" : ""}${editable ? "" : " mf-readonly"}`}
       data-param={name}
       data-live={live ? "true" : "false"}
+      data-changed={changed ? "true" : "false"}
     >
       <div className="mf-head">
         <label className="mf-label" htmlFor={editable ? id : undefined}>
@@ -202,6 +243,15 @@ function ParamRow({
           )}
         </label>
         {live && <span className="mf-badge mf-badge-live">live</span>}
+        {changed && (
+          <span
+            className="mf-badge mf-badge-changed"
+            data-changed-param={name}
+            title={`Changed since the pipeline was loaded: the file says ${summarize(fileValue, 200)}`}
+          >
+            changed · file: {summarize(fileValue, 24)}
+          </span>
+        )}
         <span className="mf-type">{describeType(field)}</span>
         {field.hasDefault && (
           <span className={`mf-default${isDefault ? "" : " mf-changed"}`}>

@@ -8,7 +8,8 @@ import { Handle, Position, type Node, type NodeProps } from "@xyflow/react";
 import { createContext, memo, useContext } from "react";
 import type { BlockInfo } from "../../engine/protocol";
 import type { Telemetry } from "../../engine/runtime/runtime";
-import { useTelemetrySelector } from "../client/hooks";
+import { useLiveBlock, useTelemetrySelector } from "../client/hooks";
+import { changedParams } from "../editor/live-values";
 import {
   formatRate,
   StatusIcon,
@@ -149,7 +150,9 @@ function BlockNodeComponent({ data }: NodeProps<BlockNodeType>) {
           </button>
         )}
       </div>
-      <div className="block-node__type">{b.type}</div>
+      <div className="block-node__type">
+        {b.type} <ChangedMark block={b} />
+      </div>
       <div className="block-node__status" aria-label={`status: ${label}`}>
         <span className="block-node__status-item">
           <StatusIcon status={v.status} />
@@ -190,6 +193,29 @@ function BlockNodeComponent({ data }: NodeProps<BlockNodeType>) {
         aria-label={edit ? `output of ${b.name}` : undefined}
       />
     </div>
+  );
+}
+
+/** "changed": live params the engine runs with values other than the file's (issue 17, defect 1). */
+function ChangedMark({ block }: { block: BlockInfo }) {
+  const live = useLiveBlock(block);
+  const changed = changedParams(live);
+  if (changed.length === 0) return null;
+  const list = changed
+    .map(
+      (p) =>
+        `${p} = ${JSON.stringify(live.params[p])} (file: ${JSON.stringify(live.fileParams?.[p])})`,
+    )
+    .join("\n");
+  return (
+    <span
+      className="block-node__changed"
+      data-changed={changed.join(",")}
+      title={`Changed since loaded:\n${list}`}
+      aria-label={`${changed.length} live value${changed.length === 1 ? "" : "s"} changed since loaded`}
+    >
+      changed
+    </span>
   );
 }
 

@@ -21,6 +21,9 @@ import {
 } from "@xyflow/react";
 import { useCallback, useEffect, useMemo, useRef, useState } from "react";
 import type { GraphInfo } from "../../engine/protocol";
+import { useUi } from "../app/ui-context";
+import { useLiveChanges } from "../app/use-live-values";
+import { describeChanges } from "../editor/live-values";
 import { BlockMenu } from "./block-menu";
 import { BlockNode, GraphStateContext, type BlockNodeType, type GraphState } from "./block-node";
 import { initialBoxes, rememberBoxes, type Boxes } from "./boxes";
@@ -279,6 +282,8 @@ function Table(props: BlockTableProps) {
     requestAnimationFrame(() => fit(duration));
   };
 
+  const changes = useLiveChanges();
+  const { writeLiveValues } = useUi();
   const saveLayout = (): void => {
     if (source === undefined) return;
     try {
@@ -286,7 +291,12 @@ function Table(props: BlockTableProps) {
       const text = updateLayout(source, positions, boxes);
       const name = graph.file.split("/").pop() || "pipeline.yaml";
       download(name, text);
-      props.onNotify(`Saved the layout into ${name} (downloaded)`);
+      // The layout only: live values changed since loaded are not in it, and it says so.
+      const left =
+        changes.length > 0
+          ? `; not the live values (${describeChanges(changes)}): Write live values to keep them`
+          : "";
+      props.onNotify(`Saved the layout into ${name} (downloaded)${left}`);
     } catch (err) {
       props.onNotify(`Cannot save the layout: ${(err as Error).message}`, "error");
     }
@@ -373,6 +383,16 @@ function Table(props: BlockTableProps) {
             >
               Save layout…
             </button>
+            {changes.length > 0 && writeLiveValues ? (
+              <button
+                type="button"
+                className="graph-actions__write-live"
+                onClick={writeLiveValues}
+                title={`Write the live values changed since loading into the pipeline file (comments kept) and download it: ${describeChanges(changes, 10)}`}
+              >
+                Write live values ({changes.length})…
+              </button>
+            ) : null}
           </Panel>
           <Panel position="bottom-right">
             <Legend />

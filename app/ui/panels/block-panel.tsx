@@ -16,7 +16,8 @@ import {
   type ReactNode,
 } from "react";
 import type { BlockInfo } from "../../engine/protocol";
-import { useEngine, useEngineState } from "../client/hooks";
+import { useUi } from "../app/ui-context";
+import { useEngine, useEngineState, useLiveBlock } from "../client/hooks";
 import { ParamsForm, type SetResult } from "../forms/params-form";
 import { HEATMAP_DEFAULTS, Heatmap, type HeatmapSettings } from "./heatmap";
 import { LabelDisplay } from "./labels";
@@ -139,14 +140,7 @@ export function BlockPanel({
   const active = visible && isData;
   let body: ReactNode;
   if (tab === "params") {
-    body = (
-      <ParamsForm
-        block={block}
-        engineState={engineState}
-        onSet={onSet}
-        {...(onEditStatic ? { onEditStatic } : {})}
-      />
-    );
+    body = <LiveParamsForm block={block} onSet={onSet} onEditStatic={onEditStatic} />;
   } else if (tab === "status") {
     body = <StatusView block={block} recorder={recorder} active={visible} />;
   } else if (tab === "label") {
@@ -306,5 +300,29 @@ function Actions({ block, loaded }: { block: BlockInfo; loaded: boolean }): Reac
         </p>
       )}
     </details>
+  );
+}
+
+/** The params form with the engine's current values (any client's changes) and the file's. */
+function LiveParamsForm({
+  block,
+  onSet,
+  onEditStatic,
+}: {
+  block: BlockInfo;
+  onSet: (param: string, value: unknown) => Promise<SetResult>;
+  onEditStatic: ((param: string, value: unknown) => Promise<SetResult>) | undefined;
+}): ReactNode {
+  const live = useLiveBlock(block);
+  const engineState = useEngineState();
+  const { writeLiveValues } = useUi();
+  return (
+    <ParamsForm
+      block={live}
+      engineState={engineState}
+      onSet={onSet}
+      {...(onEditStatic ? { onEditStatic } : {})}
+      {...(writeLiveValues ? { onWriteBack: writeLiveValues } : {})}
+    />
   );
 }

@@ -1,0 +1,172 @@
+/**
+ * One truth for params (issue 17, defect 1): with two tabs on `mosaic serve`, a live param
+ * changed in either shows in both (the form's value and its "changed since loaded" marker, the
+ * graph node's), a reloaded tab shows the engine's value, and "Write live values back to the
+ * file" downloads the pipeline's text with the new value and every comment kept, after which the
+ * markers clear in both tabs. Save layout says which live values it leaves out.
+ */
+import type { ChildProcess } from "node:child_process";
+import { readFileSync } from "node:fs";
+import { join } from "node:path";
+import type { Download, Page } from "playwright-core";
+import { afterAll, beforeAll, describe, expect, test } from "vitest";
+import { requireBuild, startCli } from "../integration/helpers";
+import {
+  artifact,
+  ensureWebBuild,
+  haveChromium,
+  launchChromium,
+  openApp,
+  ROOT,
+  type AppPage,
+  type Chromium,
+} from "./harness";
+
+const PANEL = '[data-panel="Amplification"]';
+const VALUE = `${PANEL} [data-param="Value"]`;
+const NODE_MARK = '.block-node[data-block="Amplification"] .block-node__changed';
+const DEMO = readFileSync(join(ROOT, "pipelines/demo.yaml"), "utf8");
+
+async function serve(): Promise<{ cli: ChildProcess; url: string }> {
+  const cli = startCli(["serve", "pipelines/demo.yaml", "--port", "0"]);
+  let out = "";
+  const url = await new Promise<string>((resolve, reject) => {
+    const t = setTimeout(() => reject(new Error(`no URL printed: ${out}`)), 30_000);
+    const seen = (d: Buffer) => {
+      out += d.toString();
+      const m = /MOSAIC is at (\S+)/.exec(out);
+      if (m) {
+        clearTimeout(t);
+        resolve(m[1]!);
+      }
+    };
+    cli.stdout!.on("data", seen);
+    cli.stderr!.on("data", (d: Buffer) => (out += d.toString()));
+  });
+  return { cli, url };
+}
+
+/** Opens the Amplification block's params form (its panel opened from the graph node). */
+async function openParams(page: Page): Promise<void> {
+  if ((await page.locator(PANEL).count()) === 0)
+    await page.click('.block-node[data-block="Amplification"]');
+  await page.click(`${PANEL} [data-tab="params"]`);
+  await page.waitForSelector(`${VALUE} input`);
+}
+
+async function setValue(page: Page, v: number): Promise<void> {
+  const input = page.locator(`${VALUE} input`);
+  await input.fill(String(v));
+  await input.press("Enter");
+}
+
+/** Waits until the form shows the value `v`. */
+async function expectValue(page: Page, v: number): Promise<void> {
+  const input = JSON.stringify(`${VALUE} input`);
+  await page.waitForFunction(`document.querySelector(${input})?.value === "${v}"`, undefined, {
+    timeout: 15_000,
+  });
+}
+
+/** Waits until the form shows `v` and the markers (form row, graph node) say changed or not. */
+async function expectShown(page: Page, v: number, changed: boolean): Promise<void> {
+  await expectValue(page, v);
+  await page.waitForFunction(
+    `document.querySelector(${JSON.stringify(VALUE)})?.getAttribute("data-changed") === "${changed}" && ` +
+      `(document.querySelector(${JSON.stringify(NODE_MARK)}) !== null) === ${changed}`,
+    undefined,
+    { timeout: 15_000 },
+  );
+}
+
+async function downloadText(page: Page, click: () => Promise<void>): Promise<string> {
+  const [dl] = (await Promise.all([page.waitForEvent("download"), click()])) as [Download, void];
+  return readFileSync((await dl.path())!, "utf8");
+}
+
+describe.skipIf(!haveChromium)("live params on mosaic serve (two tabs)", () => {
+  let cli: ChildProcess;
+  let url: string;
+  let browser: Chromium;
+  let a: AppPage;
+  let b: AppPage;
+
+  beforeAll(async () => {
+    ensureWebBuild();
+    requireBuild();
+    ({ cli, url } = await serve());
+    browser = await launchChromium();
+    a = await openApp(browser, url);
+    b = await openApp(browser, url);
+    await openParams(a.page);
+    await openParams(b.page);
+  }, 90_000);
+
+  afterAll(async () => {
+    await browser?.close();
+    if (cli && cli.exitCode === null) {
+      cli.kill("SIGINT");
+      await new Promise((r) => cli.once("exit", r));
+    }
+  });
+
+  test("a value changed in either tab shows in both, marked; a reload shows the engine's", async () => {
+    await expectValue(a.page, 5);
+    await expectValue(b.page, 5);
+    await setValue(a.page, 100);
+    // The engine's value in the other tab (it said 5 before: issue 17, defect 1) …
+    await expectValue(b.page, 100);
+    // … and both mark it as changed since loaded, in the form and on the graph node.
+    await expectShown(a.page, 100, true);
+    await expectShown(b.page, 100, true);
+    await b.page.screenshot({ path: artifact("live-params-second-tab.png") });
+    // The marker names the file's value.
+    expect(await b.page.textContent(`${VALUE} [data-changed-param="Value"]`)).toContain("file: 5");
+
+    await setValue(b.page, 7);
+    await expectShown(a.page, 7, true);
+    await b.page.reload();
+    await b.page.waitForSelector('.app[data-engine-state="running"]', { timeout: 15_000 });
+    await openParams(b.page);
+    await expectShown(b.page, 7, true);
+
+    // Back to the file's value: no marker anywhere.
+    await setValue(b.page, 5);
+    await expectShown(a.page, 5, false);
+    await expectShown(b.page, 5, false);
+    expect(a.errors).toEqual([]);
+    expect(b.errors).toEqual([]);
+  }, 120_000);
+
+  test("Save layout says which live values it leaves out", async () => {
+    await setValue(a.page, 100);
+    await expectShown(a.page, 100, true);
+    const text = await downloadText(a.page, () => a.page.click("button:has-text('Save layout')"));
+    expect(text).toContain("Value: 5 }");
+    await a.page.waitForFunction(
+      `/not the live values \\(Amplification\\.Value = 100\\)/.test(document.querySelector(".notice")?.textContent ?? "")`,
+      undefined,
+      { timeout: 10_000 },
+    );
+  }, 60_000);
+
+  test("write-back: the file gets the value, comments kept; the markers clear in both tabs", async () => {
+    await expectShown(b.page, 100, true);
+    const text = await downloadText(a.page, () =>
+      a.page.click(`${PANEL} button:has-text("Write live values back to the file")`),
+    );
+    // Only the value changed: every comment and line of the file is there as it was.
+    expect(text).toBe(
+      DEMO.replace("Operation: multiply, Value: 5 }", "Operation: multiply, Value: 100 }"),
+    );
+    await expectShown(a.page, 100, false);
+    await expectShown(b.page, 100, false);
+    // A tab opened now has the written text too (its Save layout keeps the value).
+    const c = await openApp(browser, url);
+    const saved = await downloadText(c.page, () => c.page.click("button:has-text('Save layout')"));
+    expect(saved).toContain("Operation: multiply, Value: 100 }");
+    expect(saved).toContain("# Paper Table 5 chain: amplification, rectification");
+    expect([...a.errors, ...b.errors, ...c.errors]).toEqual([]);
+    await c.close();
+  }, 60_000);
+});
