@@ -15,6 +15,7 @@
  * last channel, which counts samples (+1 per sample, wrapping at 16 bits), finds it again after
  * malformed bytes and counts samples the device skipped.
  */
+import { CounterAlignedParser, type CounterFraming, u16be } from "./counter-aligned-parser";
 
 /** The SyncStation's address on its own Wi-Fi network and its TCP port (the original's). */
 export const MUOVI_HOST = "192.168.76.1";
@@ -90,159 +91,38 @@ export function probeCommand(go: boolean): number {
 export const syncStationChannels = (probes: number): number =>
   probes * MUOVI_WIRE_CHANNELS + SYNCSTATION_CHANNELS;
 
-/** Whole samples in a row whose counters follow each other before an alignment is trusted. */
-export const LOCK_SAMPLES = 3;
+export { LOCK_SAMPLES } from "./counter-aligned-parser";
 /** The largest jump of the counter taken for samples the device skipped (1 s at 2 kHz). */
 export const MAX_GAP = 2000;
 
+/** Int16 big-endian values, the last one a counter (+1 per sample). */
+function muoviFraming(channels: number): CounterFraming<Int16Array> {
+  const sampleBytes = channels * 2;
+  return {
+    sampleBytes,
+    maxGap: MAX_GAP,
+    noCounter: `no sample counter (the last of ${channels} channels, +1 per sample) in the data: not a Muovi stream, or misaligned`,
+    counter: (b, at) => u16be(b, at + sampleBytes - 2),
+    decode(b, at, raw) {
+      for (let ch = 0; ch < channels; ch++) raw[ch] = u16be(b, at + 2 * ch);
+    },
+  };
+}
+
 /**
  * Splits an int16 big-endian stream of `channels` values per sample into samples, aligned by the
- * last channel (a counter, +1 per sample). `onSample(raw)` gets each sample's values (reused:
- * copy what you keep). A counter that jumps ahead and goes on counting from there is a gap
- * (`lostSamples`; a jump back or beyond MAX_GAP that counts on for LOCK_SAMPLES is a restart,
- * `counterJumps`); one that does not is misalignment: counted (`malformed`, once per episode),
- * bytes skipped (`skippedBytes`) until `LOCK_SAMPLES` samples in a row count again.
+ * last channel (a counter, +1 per sample): see CounterAlignedParser for gaps, restarts and
+ * misalignment.
  */
-export class MuoviStreamParser {
-  readonly sampleBytes: number;
-  private buf: Uint8Array;
-  private len = 0;
-  private expected = -1;
-  private inBadRun = false;
-  private readonly raw: Int16Array;
-  samples = 0;
-  lostSamples = 0;
-  /** Times the counter restarted or jumped by more than MAX_GAP and counted on from there. */
-  counterJumps = 0;
-  malformed = 0;
-  skippedBytes = 0;
-  lastProblem = "";
-
+export class MuoviStreamParser extends CounterAlignedParser<Int16Array> {
   constructor(
     readonly channels: number,
-    private readonly onSample: (raw: Int16Array) => void,
+    onSample: (raw: Int16Array) => void,
   ) {
     if (!Number.isInteger(channels) || channels < 2) {
       throw new Error(`a Muovi stream has at least 2 channels per sample, not ${channels}`);
     }
-    this.sampleBytes = channels * 2;
-    this.raw = new Int16Array(channels);
-    this.buf = new Uint8Array(this.sampleBytes * 64);
-  }
-
-  /** Bytes held (part of a sample, or a search for the alignment). */
-  get held(): number {
-    return this.len;
-  }
-
-  /** Forgets the alignment and what is held (a new connection); returns the bytes dropped. */
-  reset(): number {
-    const held = this.len;
-    this.len = 0;
-    this.expected = -1;
-    this.inBadRun = false;
-    return held;
-  }
-
-  feed(chunk: Uint8Array): void {
-    if (this.len + chunk.length > this.buf.length) {
-      let size = this.buf.length;
-      while (size < this.len + chunk.length) size *= 2;
-      const bigger = new Uint8Array(size);
-      bigger.set(this.buf.subarray(0, this.len));
-      this.buf = bigger;
-    }
-    this.buf.set(chunk, this.len);
-    this.len += chunk.length;
-    const used = this.drain();
-    this.buf.copyWithin(0, used, this.len);
-    this.len -= used;
-  }
-
-  /** The counter (u16) of the sample starting at byte `at`. */
-  private counter(at: number): number {
-    const i = at + this.sampleBytes - 2;
-    return (this.buf[i]! << 8) | this.buf[i + 1]!;
-  }
-
-  /** The first offset ≥ `from` where LOCK_SAMPLES counters follow each other, or -1. */
-  private findLock(from: number): number {
-    const S = this.sampleBytes;
-    for (let o = from; o + LOCK_SAMPLES * S <= this.len; o++) {
-      let ok = true;
-      for (let k = 1; k < LOCK_SAMPLES && ok; k++) {
-        ok = this.counter(o + k * S) === ((this.counter(o) + k) & 0xffff);
-      }
-      if (ok) return o;
-    }
-    return -1;
-  }
-
-  private misaligned(why: string): void {
-    if (this.inBadRun) return;
-    this.malformed++;
-    this.inBadRun = true;
-    this.lastProblem = why;
-  }
-
-  /** Consumes whole samples; returns the bytes used. */
-  private drain(): number {
-    const S = this.sampleBytes;
-    let at = 0;
-    while (this.len - at >= S) {
-      if (this.expected < 0) {
-        if (this.len - at < LOCK_SAMPLES * S) break;
-        const o = this.findLock(at);
-        if (o < 0) {
-          // Keep what could still start an aligned run; the rest is skipped.
-          const skip = this.len - at - (LOCK_SAMPLES * S - 1);
-          this.skippedBytes += skip;
-          at += skip;
-          this.misaligned(
-            `no sample counter (the last of ${this.channels} channels, +1 per sample) in the data: not a Muovi stream, or misaligned`,
-          );
-          break;
-        }
-        if (o > at) {
-          this.misaligned(`${o - at} bytes before the first whole sample`);
-          this.skippedBytes += o - at;
-        }
-        at = o;
-        this.expected = this.counter(at);
-        this.inBadRun = false;
-      }
-      const c = this.counter(at);
-      if (c !== this.expected) {
-        if (this.len - at < 2 * S) break; // the next sample says which
-        const gap = (c - this.expected) & 0xffff;
-        if (gap <= MAX_GAP && this.counter(at + S) === ((c + 1) & 0xffff)) {
-          this.lostSamples += gap;
-        } else if (this.len - at < LOCK_SAMPLES * S) {
-          break; // a restarted counter or misalignment: the next samples say which
-        } else if (this.findLock(at) === at) {
-          // The counter restarted (or jumped further than a gap) and counts on, aligned.
-          this.counterJumps++;
-        } else {
-          this.misaligned(
-            `sample counter ${c} where ${this.expected} was due and no count follows: misaligned`,
-          );
-          this.expected = -1;
-          this.skippedBytes++;
-          at++;
-          continue;
-        }
-      }
-      const b = this.buf;
-      for (let ch = 0; ch < this.channels; ch++) {
-        const i = at + 2 * ch;
-        this.raw[ch] = (b[i]! << 8) | b[i + 1]!;
-      }
-      this.expected = (c + 1) & 0xffff;
-      this.samples++;
-      at += S;
-      this.onSample(this.raw);
-    }
-    return at;
+    super(muoviFraming(channels), new Int16Array(channels), onSample);
   }
 }
 

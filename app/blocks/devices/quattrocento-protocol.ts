@@ -16,6 +16,7 @@
  * LOCK_SAMPLES samples in a row count up, finds it again after malformed bytes and counts the
  * samples the device skipped.
  */
+import { CounterAlignedParser, type CounterFraming, u16le } from "./counter-aligned-parser";
 import { crc8 } from "./muovi-protocol";
 
 /** The Quattrocento's default address (link-local, on its Ethernet port) and TCP port. */
@@ -177,192 +178,48 @@ export function quattrocentoCommand(c: QuattrocentoConfig, acquire: boolean): Ui
 /** Whether this machine stores an int16 little-endian, as the wire does (then samples are copied). */
 const LITTLE_ENDIAN = new Uint8Array(Uint16Array.of(1).buffer)[0] === 1;
 
-/** Whole samples in a row whose counters follow each other before an alignment is trusted. */
-export const LOCK_SAMPLES = 3;
+export { LOCK_SAMPLES } from "./counter-aligned-parser";
 /** The largest jump of the counter taken for samples the device skipped (1 s at 10240 Hz). */
 export const MAX_GAP = 10240;
 
 /**
- * Splits an int16 little-endian stream of `channels` values per sample into samples, aligned by
- * the sample counter (accessory channel 1, at `channels − 8`, +1 per sample). `onSample(raw)`
- * gets each sample's values (reused: copy what you keep). A counter that jumps ahead (at most
- * MAX_GAP) and counts on from there is a gap (`lostSamples`); one that jumps back or further and
- * counts on for LOCK_SAMPLES is a restart (`counterJumps`); one that does neither is
- * misalignment: counted (`malformed`, once per episode), bytes skipped (`skippedBytes`) until
- * LOCK_SAMPLES samples in a row count again.
+ * Int16 little-endian values, the sample counter at accessory channel 1 (`channels − 8`). A sample
+ * at an even offset is copied through an int16 view of the buffer where the machine is
+ * little-endian too.
  */
-export class QuattrocentoStreamParser {
-  readonly sampleBytes: number;
-  private readonly counterAt: number;
-  private buf: Uint8Array;
-  /** `buf` as int16 (its byte length is even): a sample at an even offset is copied from it. */
-  private words: Int16Array;
-  private len = 0;
-  private expected = -1;
-  private inBadRun = false;
-  private readonly raw: Int16Array;
-  samples = 0;
-  lostSamples = 0;
-  counterJumps = 0;
-  malformed = 0;
-  skippedBytes = 0;
-  lastProblem = "";
+function quattrocentoFraming(channels: number): CounterFraming<Int16Array> {
+  const counterAt = 2 * counterChannel(channels);
+  let words: Int16Array<ArrayBufferLike> = new Int16Array(0);
+  return {
+    sampleBytes: channels * 2,
+    maxGap: MAX_GAP,
+    noCounter: `no sample counter (channel ${counterChannel(channels) + 1} of ${channels}, +1 per sample) in the data: not a Quattrocento stream of ${channels} channels, or misaligned`,
+    counter: (b, at) => u16le(b, at + counterAt),
+    decode(b, at, raw) {
+      if (LITTLE_ENDIAN && (at & 1) === 0 && (b.byteOffset & 1) === 0) {
+        if (words.buffer !== b.buffer)
+          words = new Int16Array(b.buffer, b.byteOffset, b.length >> 1);
+        raw.set(words.subarray(at >> 1, (at >> 1) + raw.length));
+      } else for (let ch = 0, i = at; ch < raw.length; ch++, i += 2) raw[ch] = u16le(b, i);
+    },
+  };
+}
 
+/**
+ * Splits an int16 little-endian stream of `channels` values per sample into samples, aligned by
+ * the sample counter (accessory channel 1, at `channels − 8`, +1 per sample): see
+ * CounterAlignedParser for gaps, restarts and misalignment.
+ */
+export class QuattrocentoStreamParser extends CounterAlignedParser<Int16Array> {
   constructor(
     readonly channels: number,
-    private readonly onSample: (raw: Int16Array) => void,
+    onSample: (raw: Int16Array) => void,
   ) {
     if (!Number.isInteger(channels) || channels <= ACCESSORY_CHANNELS) {
       throw new Error(
         `a Quattrocento sample has more than ${ACCESSORY_CHANNELS} channels, not ${channels}`,
       );
     }
-    this.sampleBytes = channels * 2;
-    this.counterAt = 2 * counterChannel(channels);
-    this.raw = new Int16Array(channels);
-    this.buf = new Uint8Array(this.sampleBytes * 64);
-    this.words = new Int16Array(this.buf.buffer);
-  }
-
-  /** Bytes held (part of a sample, or a search for the alignment). */
-  get held(): number {
-    return this.len;
-  }
-
-  reset(): number {
-    const held = this.len;
-    this.len = 0;
-    this.expected = -1;
-    this.inBadRun = false;
-    return held;
-  }
-
-  feed(chunk: Uint8Array): void {
-    if (this.len + chunk.length > this.buf.length) {
-      let size = this.buf.length;
-      while (size < this.len + chunk.length) size *= 2;
-      const bigger = new Uint8Array(size);
-      bigger.set(this.buf.subarray(0, this.len));
-      this.buf = bigger;
-      this.words = new Int16Array(bigger.buffer);
-    }
-    this.buf.set(chunk, this.len);
-    this.len += chunk.length;
-    const used = this.drain();
-    this.buf.copyWithin(0, used, this.len);
-    this.len -= used;
-  }
-
-  /** The counter (u16, little-endian) of the sample starting at byte `at`. */
-  private counter(at: number): number {
-    const i = at + this.counterAt;
-    return this.buf[i]! | (this.buf[i + 1]! << 8);
-  }
-
-  /** Whether the counters of LOCK_SAMPLES samples from `at` follow each other. */
-  private counts(at: number): boolean {
-    const S = this.sampleBytes;
-    const c0 = this.counter(at);
-    for (let k = 1; k < LOCK_SAMPLES; k++) {
-      if (this.counter(at + k * S) !== ((c0 + k) & 0xffff)) return false;
-    }
-    return true;
-  }
-
-  /** The first offset ≥ `from` where LOCK_SAMPLES counters follow each other, or -1. */
-  private findLock(from: number): number {
-    const last = this.len - LOCK_SAMPLES * this.sampleBytes;
-    for (let o = from; o <= last; o++) if (this.counts(o)) return o;
-    return -1;
-  }
-
-  private misaligned(why: string): void {
-    if (this.inBadRun) return;
-    this.malformed++;
-    this.inBadRun = true;
-    this.lastProblem = why;
-  }
-
-  /** Finds an alignment from `at`; returns the offset of the first whole sample, or -1. */
-  private lock(at: number): number {
-    const o = this.findLock(at);
-    if (o < 0) {
-      this.misaligned(
-        `no sample counter (channel ${counterChannel(this.channels) + 1} of ${this.channels}, +1 per sample) in the data: not a Quattrocento stream of ${this.channels} channels, or misaligned`,
-      );
-      return -1;
-    }
-    if (o > at) {
-      this.misaligned(`${o - at} bytes before the first whole sample`);
-      this.skippedBytes += o - at;
-    }
-    this.expected = this.counter(o);
-    this.inBadRun = false;
-    return o;
-  }
-
-  /**
-   * Whether the sample at `at`, whose counter is not the expected one, starts a gap or a
-   * restart (true: take it), is misaligned (false), or needs more bytes (undefined).
-   */
-  private jumped(at: number, c: number): boolean | undefined {
-    const S = this.sampleBytes;
-    if (this.len - at < 2 * S) return undefined;
-    const gap = (c - this.expected) & 0xffff;
-    if (gap <= MAX_GAP && this.counter(at + S) === ((c + 1) & 0xffff)) {
-      this.lostSamples += gap;
-      return true;
-    }
-    if (this.len - at < LOCK_SAMPLES * S) return undefined;
-    if (this.counts(at)) {
-      this.counterJumps++;
-      return true;
-    }
-    return false;
-  }
-
-  /** Consumes whole samples; returns the bytes used. */
-  private drain(): number {
-    const S = this.sampleBytes;
-    const b = this.buf;
-    let at = 0;
-    while (this.len - at >= S) {
-      if (this.expected < 0) {
-        if (this.len - at < LOCK_SAMPLES * S) break;
-        const o = this.lock(at);
-        if (o < 0) {
-          // Keep what could still start an aligned run; the rest is skipped.
-          const skip = this.len - at - (LOCK_SAMPLES * S - 1);
-          this.skippedBytes += skip;
-          at += skip;
-          break;
-        }
-        at = o;
-      }
-      const c = this.counter(at);
-      if (c !== this.expected) {
-        const take = this.jumped(at, c);
-        if (take === undefined) break;
-        if (!take) {
-          this.misaligned(
-            `sample counter ${c} where ${this.expected} was due and no count follows: misaligned`,
-          );
-          this.expected = -1;
-          this.skippedBytes++;
-          at++;
-          continue;
-        }
-      }
-      const raw = this.raw;
-      if (LITTLE_ENDIAN && (at & 1) === 0)
-        raw.set(this.words.subarray(at >> 1, (at >> 1) + raw.length));
-      else
-        for (let ch = 0, i = at; ch < raw.length; ch++, i += 2) raw[ch] = b[i]! | (b[i + 1]! << 8);
-      this.expected = (c + 1) & 0xffff;
-      this.samples++;
-      at += S;
-      this.onSample(raw);
-    }
-    return at;
+    super(quattrocentoFraming(channels), new Int16Array(channels), onSample);
   }
 }

@@ -18,7 +18,7 @@
  * whether the device wraps it at 16 or 24 bits), finds it again after malformed bytes and counts
  * samples the device skipped.
  */
-import type { StreamParser } from "./stream-link";
+import { CounterAlignedParser, type CounterFraming, u16be } from "./counter-aligned-parser";
 
 /** The TCP port the device connects to (the manual's default). */
 export const SESSANTAQUATTRO_PORT = 45454;
@@ -140,208 +140,49 @@ export function mvPerBit(kind: ChannelKind, highRes: boolean): number {
   return 1;
 }
 
-/** Whole samples in a row whose counters follow each other before an alignment is trusted. */
-export const LOCK_SAMPLES = 3;
+export { LOCK_SAMPLES } from "./counter-aligned-parser";
 /** The largest jump of the counter taken for samples the device skipped (1 s at 4 kHz). */
 export const MAX_GAP = 4000;
+
+/** Big-endian integers of `bytes` bytes, signed but the two accessory channels (the last two). */
+function sessantaquattroFraming(channels: number, bytes: 2 | 3): CounterFraming<Int32Array> {
+  const sampleBytes = channels * bytes;
+  const accessoryMask = bytes === 2 ? 0xffff : 0xffffff;
+  return {
+    sampleBytes,
+    maxGap: MAX_GAP,
+    noCounter: `no sample counter (the last of ${channels} channels, +1 per sample) in the data: not a Sessantaquattro stream of these settings, or misaligned`,
+    counter: (b, at) => u16be(b, at + sampleBytes - 2),
+    decode(b, at, raw) {
+      if (bytes === 2) {
+        for (let ch = 0; ch < channels; ch++) raw[ch] = (u16be(b, at + 2 * ch) << 16) >> 16;
+      } else {
+        for (let ch = 0, i = at; ch < channels; ch++, i += 3) {
+          raw[ch] = (((b[i]! << 16) | (b[i + 1]! << 8) | b[i + 2]!) << 8) >> 8;
+        }
+      }
+      raw[channels - 2] = raw[channels - 2]! & accessoryMask;
+      raw[channels - 1] = raw[channels - 1]! & accessoryMask;
+    },
+  };
+}
 
 /**
  * Splits the stream into samples of `channels` big-endian integers of `bytes` bytes (2 or 3),
  * aligned by the last channel (a counter, +1 per sample; its 16 low bits are compared).
  * `onSample(raw)` gets each sample's values (reused: copy what you keep): signed, but the two
- * accessory channels (the last two) unsigned. A counter that jumps ahead and counts on from
- * there is a gap (`lostSamples`); a jump back or beyond MAX_GAP that counts on for LOCK_SAMPLES
- * is a restart (`counterJumps`); one that does not count on is misalignment: counted
- * (`malformed`, once per episode), bytes skipped (`skippedBytes`) until LOCK_SAMPLES samples in a
- * row count again.
+ * accessory channels (the last two) unsigned. Gaps, restarts and misalignment: see
+ * CounterAlignedParser.
  */
-export class SessantaquattroStreamParser implements StreamParser {
-  readonly sampleBytes: number;
-  private buf: Uint8Array;
-  private len = 0;
-  /** The counter due next (16 bits), -1 while the alignment is searched for. */
-  private expected = -1;
-  private inBadRun = false;
-  private readonly raw: Int32Array;
-  samples = 0;
-  lostSamples = 0;
-  counterJumps = 0;
-  malformed = 0;
-  skippedBytes = 0;
-  lastProblem = "";
-
+export class SessantaquattroStreamParser extends CounterAlignedParser<Int32Array> {
   constructor(
     readonly channels: number,
     readonly bytes: 2 | 3,
-    private readonly onSample: (raw: Int32Array) => void,
+    onSample: (raw: Int32Array) => void,
   ) {
     if (!Number.isInteger(channels) || channels < 3) {
       throw new Error(`a Sessantaquattro sample has at least 3 channels, not ${channels}`);
     }
-    this.sampleBytes = channels * bytes;
-    this.raw = new Int32Array(channels);
-    this.buf = new Uint8Array(this.sampleBytes * 64);
-  }
-
-  reset(): number {
-    const held = this.len;
-    this.len = 0;
-    this.expected = -1;
-    this.inBadRun = false;
-    return held;
-  }
-
-  feed(chunk: Uint8Array): void {
-    this.append(chunk);
-    const used = this.drain();
-    this.buf.copyWithin(0, used, this.len);
-    this.len -= used;
-  }
-
-  private append(chunk: Uint8Array): void {
-    const need = this.len + chunk.length;
-    if (need > this.buf.length) {
-      let size = this.buf.length;
-      while (size < need) size *= 2;
-      const bigger = new Uint8Array(size);
-      bigger.set(this.buf.subarray(0, this.len));
-      this.buf = bigger;
-    }
-    this.buf.set(chunk, this.len);
-    this.len = need;
-  }
-
-  /** The 16 low bits of the counter of the sample at byte `at`. */
-  private counter(at: number): number {
-    const i = at + this.sampleBytes - 2;
-    return (this.buf[i]! << 8) | this.buf[i + 1]!;
-  }
-
-  /** Whether LOCK_SAMPLES counters from `at` follow each other. */
-  private countsOn(at: number): boolean {
-    const c = this.counter(at);
-    for (let k = 1; k < LOCK_SAMPLES; k++) {
-      if (this.counter(at + k * this.sampleBytes) !== ((c + k) & 0xffff)) return false;
-    }
-    return true;
-  }
-
-  /** The first offset ≥ `from` where the counters count on, or -1. */
-  private findLock(from: number): number {
-    const last = this.len - LOCK_SAMPLES * this.sampleBytes;
-    for (let o = from; o <= last; o++) if (this.countsOn(o)) return o;
-    return -1;
-  }
-
-  private misaligned(why: string): void {
-    if (this.inBadRun) return;
-    this.malformed++;
-    this.inBadRun = true;
-    this.lastProblem = why;
-  }
-
-  private skip(n: number): void {
-    this.skippedBytes += n;
-  }
-
-  /**
-   * Finds the alignment from `at`: returns where the aligned samples start, -1 when the bytes held
-   * cannot say yet, or (no alignment in them) where the bytes that could still start one begin,
-   * the others skipped.
-   */
-  private lock(at: number): number {
-    const S = this.sampleBytes;
-    if (this.len - at < LOCK_SAMPLES * S) return -1;
-    const o = this.findLock(at);
-    if (o < 0) {
-      this.misaligned(
-        `no sample counter (the last of ${this.channels} channels, +1 per sample) in the data: not a Sessantaquattro stream of these settings, or misaligned`,
-      );
-      const keep = LOCK_SAMPLES * S - 1;
-      this.skip(this.len - at - keep);
-      return this.len - keep;
-    }
-    if (o > at) {
-      this.misaligned(`${o - at} bytes before the first whole sample`);
-      this.skip(o - at);
-    }
-    this.expected = this.counter(o);
-    this.inBadRun = false;
-    return o;
-  }
-
-  /**
-   * The sample at `at` does not carry the counter due: "take" it (a gap or a restart, counted),
-   * "wait" for more bytes, or "realign".
-   */
-  private judge(at: number, c: number): "take" | "wait" | "realign" {
-    const S = this.sampleBytes;
-    if (this.len - at < 2 * S) return "wait";
-    const gap = (c - this.expected) & 0xffff;
-    if (gap <= MAX_GAP && this.counter(at + S) === ((c + 1) & 0xffff)) {
-      this.lostSamples += gap;
-      return "take";
-    }
-    if (this.len - at < LOCK_SAMPLES * S) return "wait";
-    if (this.countsOn(at)) {
-      this.counterJumps++;
-      return "take";
-    }
-    this.misaligned(
-      `sample counter ${c} where ${this.expected} was due and no count follows: misaligned`,
-    );
-    return "realign";
-  }
-
-  /** Consumes whole samples; returns the bytes used. */
-  private drain(): number {
-    const S = this.sampleBytes;
-    let at = 0;
-    while (this.len - at >= S) {
-      if (this.expected < 0) {
-        const o = this.lock(at);
-        if (o < 0) break;
-        at = o;
-        if (this.expected < 0) continue;
-      }
-      const c = this.counter(at);
-      if (c !== this.expected) {
-        const v = this.judge(at, c);
-        if (v === "wait") break;
-        if (v === "realign") {
-          this.expected = -1;
-          this.skip(1);
-          at++;
-          continue;
-        }
-      }
-      this.decode(at);
-      this.expected = (c + 1) & 0xffff;
-      this.samples++;
-      at += S;
-      this.onSample(this.raw);
-    }
-    return at;
-  }
-
-  /** The values of the sample at `at` into `raw`. */
-  private decode(at: number): void {
-    const b = this.buf;
-    const n = this.channels;
-    if (this.bytes === 2) {
-      for (let ch = 0; ch < n; ch++) {
-        const i = at + 2 * ch;
-        this.raw[ch] = (((b[i]! << 8) | b[i + 1]!) << 16) >> 16;
-      }
-      this.raw[n - 2] = this.raw[n - 2]! & 0xffff;
-      this.raw[n - 1] = this.raw[n - 1]! & 0xffff;
-    } else {
-      for (let ch = 0; ch < n; ch++) {
-        const i = at + 3 * ch;
-        this.raw[ch] = (((b[i]! << 16) | (b[i + 1]! << 8) | b[i + 2]!) << 8) >> 8;
-      }
-      this.raw[n - 2] = this.raw[n - 2]! & 0xffffff;
-      this.raw[n - 1] = this.raw[n - 1]! & 0xffffff;
-    }
+    super(sessantaquattroFraming(channels, bytes), new Int32Array(channels), onSample);
   }
 }
