@@ -102,4 +102,40 @@ describe("SessionHub (real session worker)", () => {
     await until(() => b.of("state").some((s) => s.state === "stopped"));
     cb.close();
   }, 30_000);
+
+  test("one client watches several outputs of a block; each goes on until it is unwatched", async () => {
+    const a = recorder();
+    const ca = hub.connect(a.sink);
+    ca.receive({ type: "hello", version: 1 });
+    const source = readFileSync(join(ROOT, "pipelines", "demo.yaml"), "utf8");
+    ca.receive({ type: "load", id: 1, file: "demo.yaml", source });
+    await until(() => a.of("reply").some((r) => r.id === 1));
+    ca.receive({ type: "start", id: 2 });
+    await until(() => a.of("state").some((s) => s.state === "running"));
+    const ports = () => new Set(a.of("data").map((d) => `${d.block}.${d.port}`));
+    // The participant screen watches a Stimulus's phase, cue and progress the same way.
+    ca.receive({ type: "watch", id: 3, block: "Emg", port: "emg", maxRate: 50 });
+    ca.receive({ type: "watch", id: 4, block: "Emg", port: "gesture", maxRate: 50 });
+    await until(() => ports().has("Emg.emg") && ports().has("Emg.gesture"));
+    expect(a.of("reply").filter((r) => r.id === 3 || r.id === 4)).toHaveLength(2);
+    // A second tab watching the default output shares the first watch ("emg").
+    const b = recorder();
+    const cb = hub.connect(b.sink);
+    cb.receive({ type: "hello", version: 1 });
+    cb.receive({ type: "watch", id: 1, block: "Emg", maxRate: 50 });
+    await until(() => b.of("data").length > 0);
+    expect(new Set(b.of("data").map((d) => d.port))).toEqual(new Set(["emg"]));
+    // Unwatching one output stops only that one.
+    ca.receive({ type: "unwatch", id: 5, block: "Emg", port: "gesture" });
+    await until(() => a.of("reply").some((r) => r.id === 5));
+    await new Promise((r) => setTimeout(r, 300));
+    const since = a.got.length;
+    await until(() => a.got.slice(since).filter((m) => m.type === "data").length > 2);
+    const later = a.got.slice(since).filter((m) => m.type === "data");
+    expect(new Set(later.map((d) => (d as { port: string }).port))).toEqual(new Set(["emg"]));
+    cb.close();
+    ca.receive({ type: "stop", id: 6 });
+    await until(() => a.of("state").some((s) => s.state === "stopped"));
+    ca.close();
+  }, 30_000);
 });

@@ -122,6 +122,9 @@ export function defaultSessionWorkerPath(): string {
   return join(here, "session.worker.mjs");
 }
 
+/** The hub's key of a watched block output. */
+const watchKey = (block: string, port: string): string => `${block}\u0000${port}`;
+
 export class SessionHub {
   private readonly worker: Worker;
   private doorbell: Int32Array | undefined;
@@ -305,7 +308,7 @@ export class SessionHub {
         this.broadcast(m);
         return;
       case "data": {
-        const holders = this.watchers.get(m.block);
+        const holders = this.watchers.get(watchKey(m.block, m.port));
         if (holders) for (const c of holders) if (c.open) c.sink.send(m);
         return;
       }
@@ -400,7 +403,7 @@ export class SessionHub {
         if (!client.open) return;
         client.open = false;
         this.clients.delete(client);
-        for (const block of [...client.watches]) this.unwatchFor(client, block);
+        for (const key of [...client.watches]) this.unwatchFor(client, key);
         for (const p of this.pending.values()) if (p.client === client) p.client = undefined;
       },
     };
@@ -425,7 +428,11 @@ export class SessionHub {
   }
 
   private watch(client: Client, msg: Extract<UiMessage, { type: "watch" | "unwatch" }>): void {
-    const key = msg.block;
+    // One key per output: a client may watch several outputs of a block (the participant
+    // screen: a Stimulus's phase, cue and progress). No port: the block's first output.
+    const port =
+      msg.port ?? this.graph?.blocks.find((b) => b.name === msg.block)?.outputs[0]?.name ?? "";
+    const key = watchKey(msg.block, port);
     if (msg.type === "watch") {
       const holders = this.watchers.get(key) ?? new Set<Client>();
       const first = holders.size === 0;
@@ -447,12 +454,14 @@ export class SessionHub {
     if (!holders || !holders.delete(client)) return false;
     if (holders.size > 0) return false;
     this.watchers.delete(key);
+    const [block, port] = key.split("\u0000") as [string, string];
+    const output = port !== "" ? { port } : {};
     if (replyId !== undefined && client.open) {
-      this.forward(client, { type: "unwatch", id: replyId, block: key });
+      this.forward(client, { type: "unwatch", id: replyId, block, ...output });
     } else {
       const id = this.nextId++;
       this.pending.set(id, { clientId: id });
-      this.toWorker({ type: "unwatch", id, block: key });
+      this.toWorker({ type: "unwatch", id, block, ...output });
     }
     return true;
   }
