@@ -4,10 +4,10 @@
  * socket, the desktop app's IPC or, in the browser build, the clinician page's relay). It never
  * loads or starts anything. Double-click (or F11) makes it full screen.
  */
-import { useEffect, useRef } from "react";
+import { useCallback, useEffect, useRef, useSyncExternalStore } from "react";
 import type { BlockInfo, GraphInfo } from "../../engine/protocol";
 import type { EngineClient } from "../client/engine-client";
-import { EngineContext, useEngineInfo, useGraph } from "../client/hooks";
+import { EngineContext, useEngine } from "../client/hooks";
 import { ParticipantScreen } from "./participant-screen";
 import { heldOutTrigger } from "./test-schedule";
 import "./participant.css";
@@ -40,6 +40,24 @@ function toggleFullscreen(): void {
   else void document.documentElement.requestFullscreen?.().catch(() => {});
 }
 
+/**
+ * The client's connection and graph, read again once subscribed: the first answers may come
+ * before an effect would subscribe (the browser build's relay answers within the same task).
+ */
+function useClientView(): { connected: boolean; graph: GraphInfo | undefined } {
+  const client = useEngine();
+  const subscribe = useCallback(
+    (changed: () => void) => {
+      const offs = [client.onHello(changed), client.onGraph(changed)];
+      return () => offs.forEach((off) => off());
+    },
+    [client],
+  );
+  const connected = useSyncExternalStore(subscribe, () => client.connected);
+  const graph = useSyncExternalStore(subscribe, () => client.graph);
+  return { connected, graph };
+}
+
 /** A number that changes with every new graph (a load starts the screen afresh). */
 function useGeneration(graph: GraphInfo | undefined): number {
   const seen = useRef<{ graph: GraphInfo | undefined; n: number }>({ graph, n: 0 });
@@ -48,8 +66,7 @@ function useGeneration(graph: GraphInfo | undefined): number {
 }
 
 function ParticipantRoot({ name, problem }: { name: string | undefined; problem?: string }) {
-  const graph = useGraph();
-  const info = useEngineInfo();
+  const { connected, graph } = useClientView();
   const block = participantBlock(graph, name);
   const generation = useGeneration(graph);
   useEffect(() => {
@@ -59,7 +76,7 @@ function ParticipantRoot({ name, problem }: { name: string | undefined; problem?
     return () => window.removeEventListener("dblclick", toggleFullscreen);
   }, []);
   if (problem !== undefined) return <Message text="Not connected" detail={problem} />;
-  if (!info.connected) {
+  if (!connected) {
     return (
       <Message
         text="Connecting…"

@@ -4,9 +4,10 @@
  * from telemetry, keeps an estimate of the engine's clock and re-renders ten times a second for
  * the countdown. Returns the screen model (participant-model.ts).
  */
-import { useCallback, useEffect, useMemo, useRef, useState } from "react";
+import { useCallback, useEffect, useMemo, useRef, useState, useSyncExternalStore } from "react";
 import type { BlockInfo, DataMessage } from "../../engine/protocol";
-import { useBlockData, useEngine, useEngineState, useTelemetrySelector } from "../client/hooks";
+import type { EngineState } from "../../engine/protocol";
+import { useBlockData, useEngine, useTelemetrySelector } from "../client/hooks";
 import {
   participantModel,
   phaseOf,
@@ -109,6 +110,13 @@ function useTestEvents(trigger: BlockInfo | undefined, see: (t: number) => void)
   return lastT;
 }
 
+/** The engine's state, read again once subscribed (a state may come before an effect runs). */
+function useEngineStateNow(): EngineState {
+  const client = useEngine();
+  const subscribe = useCallback((changed: () => void) => client.onState(changed), [client]);
+  return useSyncExternalStore(subscribe, () => client.state);
+}
+
 /** Re-renders every 100 ms (the countdown between data messages). */
 function useTick(): void {
   const [, tick] = useState(0);
@@ -119,7 +127,7 @@ function useTick(): void {
 }
 
 export function useParticipant(block: BlockInfo, trigger: BlockInfo | undefined): ParticipantModel {
-  const engine = useEngineState();
+  const engine = useEngineStateNow();
   const { clock, see } = useEngineClock();
   const { live, arrived } = useStimulusData(block.name, see);
   const testEventT = useTestEvents(trigger, see);
