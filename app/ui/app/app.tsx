@@ -25,8 +25,8 @@ import { saveFile } from "./save-file";
 import { UiContext, type UiActions } from "./ui-context";
 import { usePipeline, type PipelineEntry } from "./use-pipeline";
 import { useEventLog } from "./use-event-log";
-
 import { useWriteLiveValues } from "./use-live-values";
+
 const STATE_LABEL: Record<EngineState, string> = {
   empty: "no pipeline",
   loaded: "loaded",
@@ -200,8 +200,8 @@ function Shell({
       closePanel: (name) => setPanels((ps) => ps.filter((p) => p.name !== name)),
       openStimulus: (name) => setStimulus(name),
       notify,
-    }),
       writeLiveValues,
+    }),
     [notify, writeLiveValues],
   );
 
