@@ -23,6 +23,7 @@ import {
   type GraphState,
 } from "../graph/block-node";
 import { layeredLayout } from "../graph/layout";
+import { placeBlocks } from "../graph/layout-place";
 import { EdgeMarkerDefs, RateEdge, type RateEdgeType } from "../graph/rate-edge";
 import { typeIndex, type EditBlock, type EditIssue } from "./model";
 import { BLOCK_TYPE_MIME } from "./palette";
@@ -105,9 +106,16 @@ function Canvas(props: EditCanvasProps): ReactNode {
       if (i.block === undefined) continue;
       byBlock.set(i.block, [...(byBlock.get(i.block) ?? []), i.message]);
     }
+    // A block without a place yet goes to free space, beside what it reads from.
+    const positions = placeBlocks(
+      blocks.map((b) => {
+        const at = b.layout ?? placed.current.get(b.name);
+        return { name: b.name, inputs: b.inputs.map((i) => i.block), ...(at ? { at } : {}) };
+      }),
+      auto,
+    );
     const nodes = blocks.map((b): BlockNodeType => {
-      const position = b.layout ??
-        placed.current.get(b.name) ?? { x: auto.get(b.name)!.x, y: auto.get(b.name)!.y };
+      const position = positions.get(b.name)!;
       placed.current.set(b.name, position);
       return {
         id: b.name,

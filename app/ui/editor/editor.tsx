@@ -17,6 +17,7 @@ import { Inspector } from "./inspector";
 import { typeIndex, type EditIssue } from "./model";
 import { Palette } from "./palette";
 import { TextView } from "./text-view";
+import { SidePane } from "./side-pane";
 import { useEditor } from "./use-editor";
 import { issueFromDiagnostic, useValidation } from "./use-validation";
 
@@ -338,29 +339,32 @@ export function Editor(props: EditorProps): ReactNode {
           onDelete={removeSelected}
           fitKey={fitKey}
         />
-        <div className="editor__side">
-          {sel ? (
-            <Inspector
-              block={sel}
-              type={types.get(sel.type)}
-              issues={issues}
-              runningBlock={graph?.blocks.find((b) => b.name === sel.name)}
-              onRename={(to) => {
-                if (to === sel.name) return undefined;
-                const e = ed.edit((d) => d.renameBlock(sel.name, to));
-                if (e === undefined) setSelected(to);
-                return e;
-              }}
-              onDesiredRate={(r) => ed.edit((d) => d.setDesiredRate(sel.name, r))}
-              onPath={(p) => ed.edit((d) => d.setPath(sel.name, p))}
-              onInputs={(ins) => ed.edit((d) => d.setInputs(sel.name, ins))}
-              onParam={onParam}
-            />
-          ) : (
-            <p className="inspector__none">Select a block to edit it.</p>
-          )}
-          <TextView text={ed.text} issues={issues} catalog={catalog} onChange={ed.setText} />
-        </div>
+        <SidePane
+          selected={sel?.name ?? null}
+          inspector={
+            sel ? (
+              <Inspector
+                block={sel}
+                type={types.get(sel.type)}
+                issues={issues}
+                runningBlock={graph?.blocks.find((b) => b.name === sel.name)}
+                onRename={(to) => {
+                  if (to === sel.name) return undefined;
+                  const e = ed.edit((d) => d.renameBlock(sel.name, to));
+                  if (e === undefined) setSelected(to);
+                  return e;
+                }}
+                onDesiredRate={(r) => ed.edit((d) => d.setDesiredRate(sel.name, r))}
+                onPath={(p) => ed.edit((d) => d.setPath(sel.name, p))}
+                onInputs={(ins) => ed.edit((d) => d.setInputs(sel.name, ins))}
+                onParam={onParam}
+              />
+            ) : (
+              <p className="inspector__none">Select a block to edit it.</p>
+            )
+          }
+          text={<TextView text={ed.text} issues={issues} catalog={catalog} onChange={ed.setText} />}
+        />
       </div>
     </div>
   );

@@ -91,6 +91,8 @@ export function TextView({ text, issues, catalog, onChange }: TextViewProps): Re
           }),
           lintGutter(),
           keymap.of([...defaultKeymap, indentWithTab]),
+          // Long lines wrap: the pane is narrow and never scrolls sideways (issue 17, defect 8).
+          EditorView.lineWrapping,
           EditorView.contentAttributes.of({ "aria-label": "Pipeline YAML" }),
           EditorView.updateListener.of((u) => {
             if (!u.docChanged || u.transactions.some((t) => t.annotation(External))) return;
