@@ -24,12 +24,13 @@ function memoryModules(modules: Record<string, Record<string, unknown>>): Module
 }
 
 const Double = defineBlock({
-  ...TestGain,
   type: "Double",
+  category: "Testing",
   summary: "twice the input",
   help: "y = 2x",
   params: z.strictObject({}),
-  create: (ctx, _p) => TestGain.create(ctx, { Gain: 2 }),
+  inputs: { min: 1, max: 1 },
+  create: (ctx) => TestGain.create(ctx, { Gain: 2 }),
 });
 
 const Garbage = defineBlock({

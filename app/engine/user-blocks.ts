@@ -9,7 +9,7 @@
 import { isMap, type YAMLMap } from "yaml";
 import type { AnyBlockDefinition, BlockInstance } from "./block";
 import { createCatalog, type Catalog } from "./catalog";
-import type { Diagnostic } from "./diagnostics";
+import { errorMessage, type Diagnostic } from "./diagnostics";
 import { Collector, scalarString } from "./pipeline/collector";
 import { isSettingsEntry, readSettings } from "./pipeline/keys";
 import { lineCounterOf, parseStage } from "./pipeline/parse";
@@ -136,8 +136,15 @@ export async function pipelineCatalog(
     return { catalog: base, modules: [], diagnostics };
   }
   const modules: LoadedBlockModule[] = [];
+  const seen = new Map<string, BlockModuleRef>();
   for (const ref of refs) {
     const path = joinModulePath(folderOfPath(file), ref.path);
+    const first = seen.get(path);
+    if (first) {
+      error(ref, `${ref.path} is listed twice in Blocks: (also at line ${first.pos.line})`);
+      continue;
+    }
+    seen.set(path, ref);
     const r = await load(path);
     if (!r.ok) {
       const where = r.line !== undefined ? `${ref.path}:${r.line}:${r.col ?? 0}` : ref.path;
@@ -308,6 +315,39 @@ export function instanceProblem(inst: unknown): string | undefined {
   return undefined;
 }
 
+/** The first stack frame of an error in the file named `name` (a source-mapped stack). */
+export function userFrame(e: unknown, name: string): { line: number; col: number } | undefined {
+  const stack = e instanceof Error ? (e.stack ?? "") : "";
+  const escaped = name.replace(/[.*+?^${}()|[\]\\]/g, "\\$&");
+  const m = new RegExp(`[/\\\\]${escaped}:(\\d+):(\\d+)`).exec(stack);
+  return m ? { line: Number(m[1]), col: Number(m[2]) } : undefined;
+}
+
+/**
+ * The instance with its `process` errors located: "… (at blocks/mine.ts:12:7)" when the error
+ * was thrown in the module's own file, so the event names the file and line besides the block.
+ */
+function located(inst: BlockInstance, module: string): BlockInstance {
+  const process = inst.process;
+  if (!process) return inst;
+  const name = module.split(/[/\\]/).pop() ?? module;
+  const wrapped: BlockInstance["process"] = function (this: BlockInstance, frame, port) {
+    try {
+      process.call(this, frame, port);
+    } catch (e) {
+      const at = userFrame(e, name);
+      if (!at) throw e;
+      throw new Error(`${errorMessage(e)} (at ${module}:${at.line}:${at.col})`, { cause: e });
+    }
+  };
+  try {
+    inst.process = wrapped;
+  } catch {
+    // A frozen instance: its errors go out without the position.
+  }
+  return inst;
+}
+
 /**
  * The definition with its `create` checked: an instance that is not one (garbage from a user's
  * module) is refused at load, at the block's line, instead of failing later inside the runtime.
@@ -324,7 +364,7 @@ function guardUserBlock(def: AnyBlockDefinition, module: string): AnyBlockDefini
       const inst = (await create(ctx, params)) as unknown;
       const problem = instanceProblem(inst);
       if (problem) throw new Error(`user block '${def.type}' (${module}): ${problem}`);
-      return inst as BlockInstance;
+      return located(inst as BlockInstance, module);
     },
   };
   origins.set(guarded, module);

@@ -5,13 +5,15 @@
  * the reason, with the line and column of a syntax error. Results are kept per file until one of
  * the files the module was built from changes (the editor validates on every pause in typing).
  */
-import { existsSync, statSync } from "node:fs";
-import { dirname, isAbsolute, resolve } from "node:path";
+import { createHash } from "node:crypto";
+import { existsSync, mkdirSync, statSync, writeFileSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { basename, dirname, isAbsolute, join, resolve } from "node:path";
 import { pathToFileURL } from "node:url";
 import type { Message, Plugin } from "esbuild";
 import { errorMessage } from "../engine/diagnostics";
 import * as sdk from "../engine/sdk";
-import type { ModuleLoadResult } from "../engine/user-blocks";
+import { userFrame, type ModuleLoadResult } from "../engine/user-blocks";
 
 /** Where a loaded module finds the SDK (the engine's own instance: its zod, its error classes). */
 const SDK_KEY = Symbol.for("mosaic.sdk");
@@ -22,6 +24,8 @@ const SDK_IMPORT = /^(mosaic\/sdk|@mosaic\/sdk)$/;
 /** Makes `mosaic/sdk` resolvable for modules loaded in this thread. */
 export function installSdk(): void {
   (globalThis as Record<symbol, unknown>)[SDK_KEY] = sdk;
+  // Stack traces at the user's lines (the bundle carries its source map).
+  process.setSourceMapsEnabled(true);
 }
 
 /** The module text that stands for `mosaic/sdk` inside a user's bundle. */
@@ -111,25 +115,35 @@ async function loadUncached(
   const inside = refused(built.inputs, refuse);
   if (inside) return inside;
   try {
-    const url = `data:text/javascript;base64,${Buffer.from(built.code).toString("base64")}`;
-    const exports = (await import(url)) as Record<string, unknown>;
+    const exports = (await import(bundleFile(file, built.code))) as Record<string, unknown>;
     return { ok: true, exports, inputs: built.inputs };
   } catch (e) {
-    const where = errorLine(e, file);
     return {
       ok: false,
-      message: `its top level threw: ${errorMessage(e)}${where}`,
+      message: `its top level threw: ${errorMessage(e)}`,
+      ...stackPosition(e, file),
       inputs: built.inputs,
     };
   }
 }
 
-/** " (line N)" of the user's file in an error's stack (the bundle's inline source map). */
-function errorLine(e: unknown, file: string): string {
-  const stack = e instanceof Error ? (e.stack ?? "") : "";
-  const name = file.split(/[/\\]/).pop() ?? file;
-  const m = new RegExp(`${name.replace(/[.*+?^${}()|[\]\\]/g, "\\$&")}:(\\d+):(\\d+)`).exec(stack);
-  return m ? ` (at ${name}:${m[1]}:${m[2]})` : "";
+/**
+ * The bundle as a file (named by its content: the same code is one module) whose URL the
+ * import takes; a file, not a data: URL, so that Node maps stack traces to the user's lines.
+ */
+function bundleFile(file: string, code: string): string {
+  const dir = join(tmpdir(), "mosaic-block-modules");
+  mkdirSync(dir, { recursive: true });
+  const hash = createHash("sha256").update(file).update("\0").update(code).digest("hex");
+  const out = join(dir, `${basename(file).replace(/\.[^.]+$/, "")}-${hash.slice(0, 16)}.mjs`);
+  if (!existsSync(out)) writeFileSync(out, code);
+  return pathToFileURL(out).href;
+}
+
+/** Where in the user's file an error was thrown (from its source-mapped stack), if there. */
+function stackPosition(e: unknown, file: string): { line?: number; col?: number } {
+  const at = userFrame(e, basename(file));
+  return at ? { line: at.line, col: at.col } : {};
 }
 
 type Bundled =
@@ -148,6 +162,7 @@ async function bundle(file: string): Promise<Bundled> {
       platform: "node",
       target: "node20",
       sourcemap: "inline",
+      sourceRoot: `${pathToFileURL(dir).href}/`,
       metafile: true,
       logLevel: "silent",
       plugins: [sdkPlugin],

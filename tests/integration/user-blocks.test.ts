@@ -194,6 +194,22 @@ describe("broken user blocks", () => {
     }
   }, 60_000);
 
+  test("a module whose top level throws names the file and line", () => {
+    writeFileSync(
+      join(dir, "blocks/boom.ts"),
+      'const ready: boolean = false;\n\nif (!ready) {\n  throw new Error("not configured");\n}\nexport {};\n',
+    );
+    writeFileSync(
+      join(dir, "boom.yaml"),
+      "Pipeline: { Blocks: [blocks/boom.ts] }\nClock: { Type: ScheduledTimer, DesiredRate: 100 }\n",
+    );
+    const r = runCli(["validate", "boom.yaml"], { cwd: dir });
+    expect(r.code).toBe(2);
+    expect(r.stderr).toContain(
+      "boom.yaml:1:22: error: cannot load user blocks from blocks/boom.ts:4:9: its top level threw: not configured",
+    );
+  }, 60_000);
+
   test("a module that is not blocks, a missing one and a clash with a built-in are named", () => {
     writeFileSync(join(dir, "blocks/notblock.js"), "export default { foo: 1 };\n");
     writeFileSync(
@@ -235,11 +251,12 @@ describe("broken user blocks", () => {
       block: string;
       message: string;
     }[];
+    // The block, and the file and line that threw (the module's source map).
     expect(events).toContainEqual(
       expect.objectContaining({
         level: "error",
         block: "Throw",
-        message: "thrower is broken on purpose",
+        message: "thrower is broken on purpose (at blocks/broken.ts:14:15)",
       }),
     );
     const stuck = events.find((e) => e.block === "Loop");
