@@ -232,7 +232,7 @@ class KernelInstance {
     readonly channels: number,
   ) {
     this.exports = this.instantiate();
-    this.handle = this.create();
+    this.handle = this.trapped("mosaic_create", () => this.create());
     this.outputChannels = this.exports.mosaic_output_channels(this.handle);
     if (this.outputChannels < 1) throw new Error(this.fail("mosaic_output_channels"));
   }
@@ -251,6 +251,25 @@ class KernelInstance {
     x.mosaic_free(ptr, bytes);
     if (handle === 0) throw new BlockConfigError(this.lastError());
     return handle;
+  }
+
+  /**
+   * Runs `call` (a call into the module named `fn`); a trap (a Rust panic with panic = "abort",
+   * an out-of-bounds access) becomes an error that says so. With `restart`, the instance is
+   * replaced first, since its memory may be inconsistent after a trap.
+   */
+  private trapped<T>(fn: string, call: () => T, restart = false): T {
+    try {
+      return call();
+    } catch (e) {
+      if (!(e instanceof wasmApi().RuntimeError)) throw e;
+      if (restart) this.restart();
+      throw new Error(
+        `${this.checked.name} trapped in ${fn} (a Rust panic or an out-of-bounds access: ` +
+          `${errorMessage(e)})${restart ? "; the kernel was created anew, its history lost" : ""}`,
+        { cause: e },
+      );
+    }
   }
 
   /** The module's last error message. */
@@ -300,6 +319,10 @@ class KernelInstance {
   /** Runs the kernel on `frames` events of `input` (row-major) into `output`. */
   process(input: Float64Array, frames: number, output: Float64Array): void {
     if (frames === 0) return;
+    this.trapped("mosaic_process", () => this.processFrames(input, frames, output), true);
+  }
+
+  private processFrames(input: Float64Array, frames: number, output: Float64Array): void {
     this.ensureCapacity(frames);
     const nIn = frames * this.channels;
     this.view().set(input.subarray(0, nIn), this.inPtr / 8);
@@ -316,7 +339,8 @@ class KernelInstance {
   }
 
   reset(): void {
-    if (this.exports.mosaic_reset(this.handle) !== 0) throw new Error(this.fail("mosaic_reset"));
+    const status = this.trapped("mosaic_reset", () => this.exports.mosaic_reset(this.handle), true);
+    if (status !== 0) throw new Error(this.fail("mosaic_reset"));
   }
 
   destroy(): void {
@@ -328,7 +352,7 @@ class KernelInstance {
    * After a trap the module's memory may be inconsistent: replace the whole instance with a fresh
    * one (the kernel's history starts over, as after a reset).
    */
-  restart(): void {
+  private restart(): void {
     this.exports = this.instantiate();
     this.buffer = null;
     this.capacity = 0;
@@ -356,29 +380,16 @@ function inputShape(ctx: BlockContext, type: string): Shape {
   return input.shape;
 }
 
-function createInstance(kernel: KernelInstance, out: OutputPort, name: string): BlockInstance {
+function createInstance(kernel: KernelInstance, out: OutputPort): BlockInstance {
   let live: KernelInstance | null = kernel;
-  const process = (frame: Frame): void => {
-    if (live === null) return;
-    const o = out.frame(frame.n);
-    for (let e = 0; e < frame.n; e++) o.t[e] = frame.t[e]!;
-    try {
-      live.process(frame.v, frame.n, o.v);
-    } catch (e) {
-      if (e instanceof wasmApi().RuntimeError) {
-        live.restart();
-        throw new Error(
-          `${name} trapped in mosaic_process (a Rust panic or an out-of-bounds access: ` +
-            `${errorMessage(e)}); the kernel was created anew, its history lost`,
-          { cause: e },
-        );
-      }
-      throw e;
-    }
-    out.emit(o);
-  };
   return {
-    process,
+    process(frame: Frame): void {
+      if (live === null || frame.n === 0) return;
+      const o = out.frame(frame.n);
+      for (let e = 0; e < frame.n; e++) o.t[e] = frame.t[e]!;
+      live.process(frame.v, frame.n, o.v);
+      out.emit(o);
+    },
     reset: () => live?.reset(),
     dispose: () => {
       live?.destroy();
@@ -407,7 +418,7 @@ export function rustBlock<S extends z.ZodType>(options: RustBlockOptions<S>): Bl
       const kernel = new KernelInstance(checked, values, shape.rows * shape.cols);
       const sameSize = kernel.outputChannels === kernel.channels;
       const out = ctx.output(sameSize ? shape : vectorShape(kernel.outputChannels));
-      return createInstance(kernel, out, name);
+      return createInstance(kernel, out);
     },
   });
 }

@@ -219,14 +219,25 @@ describe("modules rustBlock refuses, with what to do", () => {
 });
 
 describe("a kernel that panics", () => {
-  it("is an error of its block, which then starts over and goes on", async () => {
+  it("in process is an error of its block, which then starts over and goes on; in new, a load error", async () => {
     const panicking = buildTemplate(join(work, "panics"), [
       {
         file: "src/tkeo.rs",
         from: "let (x1, x2) = (self.previous[c], self.before_previous[c]);",
         to: 'assert!(!x[c].is_nan(), "NaN input");\n                let (x1, x2) = (self.previous[c], self.before_previous[c]);',
       },
+      {
+        file: "src/tkeo.rs",
+        from: "Ok(Tkeo {",
+        to: 'assert!(channels != 7, "seven channels");\n        Ok(Tkeo {',
+      },
     ]);
+    // A panic in the kernel's new(): the block is not created, and the message says why.
+    await expect(
+      BlockHarness.create(tkeoBlock(panicking), {}, { inputs: [{ shape: vectorShape(7) }] }),
+    ).rejects.toThrow(
+      /^tkeo\.wasm trapped in mosaic_create \(a Rust panic or an out-of-bounds access: .*unreachable.*\)$/,
+    );
     const h = await harness(panicking);
     const [a, b] = frames([300]);
     h.push(a!);
