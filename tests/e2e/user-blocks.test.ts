@@ -9,7 +9,7 @@ import type { ChildProcess } from "node:child_process";
 import { mkdirSync, readFileSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
 import { afterAll, beforeAll, describe, expect, test } from "vitest";
-import { requireBuild, startCli, tempDir } from "../integration/helpers";
+import { requireBuild, runCli, startCli, tempDir } from "../integration/helpers";
 import {
   artifact,
   ensureWebBuild,
@@ -93,6 +93,10 @@ describe.skipIf(!haveChromium)("a user's block in mosaic serve's UI (Chromium)",
     const item = page.locator('.palette__item[data-block-type="Smoother"]');
     await item.waitFor({ timeout: 15_000 });
     expect(await item.textContent()).toContain("Exponential smoothing of every channel");
+    // The editor checks the text as mosaic validate does, user blocks included: no problems.
+    await page.waitForSelector('.editor[data-checking="false"][data-errors="0"]', {
+      timeout: 15_000,
+    });
     await page.screenshot({ path: artifact("user-blocks-palette.png") });
     await page.click('button:has-text("Edit")');
 
@@ -116,6 +120,31 @@ describe.skipIf(!haveChromium)("a user's block in mosaic serve's UI (Chromium)",
     expect(await page.getAttribute(".app", "data-engine-state")).toBe("running");
     await page.waitForSelector('[data-block="Smooth"][data-status="ontime"]', { timeout: 20_000 });
     writeFileSync(file, good);
+
+    // The editor checks a user block's params with its own schema, at their line, in the CLI's words.
+    const text = readFileSync(join(dir, "pipeline.yaml"), "utf8").replace("Alpha: 0.2", "Alpha: 5");
+    writeFileSync(join(dir, "too-big.yaml"), text);
+    const cli = runCli(["validate", "too-big.yaml"], { cwd: dir });
+    const want = cli.stderr.split("\n").find((l) => l.includes(": error: "))!;
+    expect(want).toMatch(/too-big\.yaml:\d+:\d+: error: block 'Smooth' \(Smoother\): .*Alpha/);
+    await page.click('button:has-text("Edit")');
+    await page.click('.text-view [aria-label="Pipeline YAML"]');
+    await page.keyboard.press("Control+a");
+    await page.keyboard.insertText(text);
+    const message = want.replace(/^.*?: error: /, "");
+    await page.waitForFunction(
+      (m) =>
+        Array.from(
+          (
+            globalThis as unknown as {
+              document: { querySelectorAll(s: string): { textContent: string | null }[] };
+            }
+          ).document.querySelectorAll(".text-view__issues li"),
+          (li) => li.textContent ?? "",
+        ).some((t) => t.includes(m)),
+      message,
+      { timeout: 20_000 },
+    );
     expect(errors).toEqual([]);
     await close();
   }, 120_000);
