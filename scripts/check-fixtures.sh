@@ -25,6 +25,7 @@ GENERATORS=(
   "app/blocks/signal/fixtures/gen_dds.py:dds.json"
   "app/blocks/signal/fixtures/gen_envelope.py:envelope_5hz.csv"
   "app/blocks/kinematics/fixtures/gen_body_rig.py:body_rig.json"
+  "app/ui/panels/fixtures/gen_training_metrics.py:training_metrics.json"
   "app/ui/panels/fixtures/gen_spectrum.py:spectrum.json"
 )
 

@@ -26,8 +26,12 @@ export type BlockCategory =
   | "Recording"
   | "Testing";
 
-/** Control-panel views a block offers (drawn by the UI). */
-export type BlockView = "scope" | "spider" | "heatmap" | "label" | "stimulus";
+/**
+ * Control-panel views a block offers (drawn by the UI): "training" is a predictor's feedback
+ * (prediction versus target, R², gestures; its model file), "player" a file player's transport.
+ */
+export type BlockView =
+  "scope" | "spider" | "heatmap" | "label" | "stimulus" | "training" | "player";
 
 export interface InputSpec {
   /** Fewest inputs the block accepts. */

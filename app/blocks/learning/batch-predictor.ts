@@ -21,7 +21,7 @@ import {
   legacyMachine,
   listR2,
   loadModel,
-  loadModelFile,
+  loadModelAction,
   MODEL_HELP,
   modelFileArg,
   modelParams,
@@ -89,7 +89,8 @@ export const BatchPredictor = defineBlock({
     MODEL_HELP +
     " A `File` that exists is loaded when the pipeline is created and replaces the model the " +
     "params describe. Actions: `train` (fit on the rows kept), `clear` (drop the rows), `reset` " +
-    "(forget the model), `save` and `load` (a file name, default File or <block>.model.json) and " +
+    "(forget the model), `save` and `load` (a file name, default File or <block>.model.json, or " +
+    "a model file's text chosen in the page: the panel's Load model from file…) and " +
     "`inspect`. MOSAIC's `[buffer, RR_RFF, 8, 12, λ, σ, D]` loads as the same model (γ = σ²/2, " +
     "λ·2/D, no intercept) with one input: as in MOSAIC it reads the named Buffer's rows when the " +
     "model is built (the train action, MOSAIC's Build model; with AutoTrain also whenever the " +
@@ -112,10 +113,11 @@ export const BatchPredictor = defineBlock({
     "Buffer name, machine, sizes and hyper-parameters)",
   inputs: { min: 1, max: 2, labels: ["features", "pairs"] },
   outputs: ["prediction", "fit"],
-  views: ["scope", "spider", "label"],
+  views: ["training", "scope", "spider", "label"],
   panel:
-    "Predictions (scope, spider), rows kept and the R² of the last fit; train, clear, reset, " +
-    "save, load and inspect buttons.",
+    "Training: its status and the model file (save, a download in the browser build, or load " +
+    "from a file); predictions (scope, spider), rows kept and the R² of the last fit; train, " +
+    "clear, reset, save, load and inspect buttons.",
   async create(ctx, p) {
     requireDsp("BatchPredictor");
     const feat = signalInput(ctx, 0, "Inputs");
@@ -458,11 +460,7 @@ export const BatchPredictor = defineBlock({
         load: {
           label: "Load model",
           description: `Replace the model by one from a file (default ${defaultFile})`,
-          run(arg) {
-            const file = modelFileArg(arg, defaultFile);
-            loadModelFile(files, file);
-            return `loading ${file}`;
-          },
+          run: (arg) => loadModelAction(files, arg, defaultFile),
         },
         inspect: {
           label: "Inspect",

@@ -237,6 +237,61 @@ describe("IncrementalPredictor", () => {
     expect(g.warnings.at(-1)).toMatch(/cannot load the model: model file 'bad.json'/);
   });
 
+  test("load with a model file's text (a file picked in the page) replaces the model at once", async () => {
+    const files: Record<string, string> = {};
+    const h = await predictor({ Lambda: 1e-6 }, 2, 2, files);
+    h.push(vectors([0], [linear(point(0))]), 1);
+    h.push(
+      vectors(
+        [1, 2, 3, 4, 5],
+        [1, 2, 3, 4, 5].map((i) => point(i)),
+      ),
+      0,
+    );
+    run(h, "save", "trained.json");
+    await settle();
+    const text = files["trained.json"]!;
+    // A block with no target (predicts only), given the text and not a file it could read.
+    const g = await predictor({ Outputs: 2 }, 2, null);
+    expect(run(g, "load", { name: "trained.json", text })).toBe(
+      "loaded trained.json: ridge (λ 0.000001)",
+    );
+    expect(g.text).toMatch(/^trained on 5 samples.*\(loaded trained\.json: ridge/);
+    const probe = vectors([10, 11], [point(7), point(8)]);
+    h.push(vectors([9], [STOP2]), 1);
+    h.push(probe, 0);
+    g.push(probe, 0);
+    expect(g.output("prediction").v).toEqual(h.output("prediction").v.slice(-2));
+    // A text that is no model, or one of other sizes, fails the action with the reason.
+    expect(() => run(g, "load", { name: "x.json", text: "{}" })).toThrow(
+      "model file 'x.json': not a MOSAIC model file",
+    );
+    const three = await predictor({ Outputs: 1 }, 3, null, files);
+    expect(() => run(three, "load", { name: "trained.json", text })).toThrow(
+      "the model has 2 inputs but input 'in0' carries 3 values per event",
+    );
+  });
+
+  test("versus: the prediction before each sample is learnt and its target; NaN targets when not learning", async () => {
+    const h = await predictor({ Lambda: 1e-6 }, 2, 2);
+    h.push(vectors([0], [linear(point(0))]), 1);
+    h.push(vectors([1, 2], [point(1), point(2)]), 0);
+    const versus = h.output("versus").v;
+    expect(versus).toHaveLength(2);
+    // The first sample is predicted by the untrained model (0) before it is learnt.
+    expect(versus[0]).toEqual([0, 0, ...linear(point(0))]);
+    // The second: predicted by the model of one sample, not the one that learnt it.
+    const afterOne = h.output("prediction").v[0]!;
+    expect(versus[1]!.slice(0, 2)).toEqual(afterOne);
+    expect(versus[1]!.slice(2)).toEqual(linear(point(0)));
+    // Not learning: the prediction itself and NaN targets.
+    h.push(vectors([3], [STOP2]), 1);
+    h.push(vectors([4], [point(4)]), 0);
+    const last = h.output("versus").v.at(-1)!;
+    expect(last.slice(0, 2)).toEqual(h.output("prediction").v.at(-1));
+    expect(last.slice(2).every(Number.isNaN)).toBe(true);
+  });
+
   test("sizes are checked against the inputs", async () => {
     await expect(predictor({ Inputs: 4 }, 3, 1)).rejects.toThrow(
       "Inputs is 4 but the features input 'in0' carries 3 values per event",

@@ -19,7 +19,7 @@ import {
   legacyMachine,
   listR2,
   loadModel,
-  loadModelFile,
+  loadModelAction,
   MODEL_HELP,
   modelFileArg,
   modelParams,
@@ -62,13 +62,17 @@ export const IncrementalPredictor = defineBlock({
     "predicted, as MOSAIC did). The `fit` output carries, for every sample learnt, [samples seen, " +
     "R² of each output]: a running, prequential R² over the training samples (each sample from " +
     "the second on is predicted before it is learnt; R² = 1 − Σe²/Σ(y − ȳ)², weighted like the " +
-    "samples with Forgetting; NaN while an output's target has not varied). Without a target " +
+    "samples with Forgetting; NaN while an output's target has not varied). The `versus` output " +
+    "(for the panel's Training view; computed only while something reads it) carries, for every " +
+    "feature event, [prediction…, target…]: while learning, the prediction made before the " +
+    "sample is learnt and the target it is learnt with, else the prediction and NaN. Without a target " +
     "input the block only predicts (give `Outputs` or a `File`). " +
     MODEL_HELP +
     " A `File` that exists is loaded when the pipeline is created and replaces the model the " +
     "params describe (its kind, sizes and hyper-parameters are the file's). Actions: `train` " +
     "(learn from targets again), `pause` (ignore targets, keep predicting), `reset` (forget " +
-    "everything), `save` and `load` (a file name, default File or <block>.model.json) and " +
+    "everything), `save` and `load` (a file name, default File or <block>.model.json, or a " +
+    "model file's text chosen in the page: the panel's Load model from file…) and " +
     "`inspect`. MOSAIC's `[IncrementalRFF, 8, 12, λ, σ, D]` loads as the same model: γ = σ²/2, " +
     "λ·2/D, no intercept. MOSAIC's `[IncrementalLDA, 8, 12]` loads as `Model: lda`: MOSAIC's " +
     "own IncrementalLDA learnt one class only and predicted a d-value 'velocity', so this is " +
@@ -99,11 +103,13 @@ export const IncrementalPredictor = defineBlock({
     "[IncrementalLDA, d, M] (MOSAIC's machine, input and output sizes, hyper-parameters); the " +
     "older [d, M] loads as IncrementalRFF",
   inputs: { min: 1, max: 2, labels: ["features", "target"] },
-  outputs: ["prediction", "fit"],
-  views: ["scope", "spider", "label"],
+  outputs: ["prediction", "fit", "versus"],
+  views: ["training", "scope", "spider", "label"],
   panel:
-    "Predictions (scope, spider) and the fit output: samples seen and the running R² of every " +
-    "output; train, pause, reset, save, load and inspect buttons.",
+    "Training: prediction versus target per output, R² per output over the recent samples and, " +
+    "for gesture targets, per-gesture accuracy and a confusion matrix; save the model (a " +
+    "download in the browser build) or load one from a file. Predictions (scope, spider) and " +
+    "the fit output; train, pause, reset, save, load and inspect buttons.",
   async create(ctx, p) {
     requireDsp("IncrementalPredictor");
     const feat = signalInput(ctx, 0, "Inputs");
@@ -184,6 +190,9 @@ export const IncrementalPredictor = defineBlock({
     const out = ctx.output(vectorShape(M), "prediction", names?.prediction);
     const fitOut = ctx.output(vectorShape(1 + M), "fit", names?.fit);
 
+    // [prediction…, target…] per feature event, for the panel's Training view (when read).
+    const versusOut = ctx.output(vectorShape(2 * M), "versus");
+
     const target = new Float64Array(M);
     let hasTarget = false;
     let paused = false;
@@ -194,6 +203,7 @@ export const IncrementalPredictor = defineBlock({
     let lastSaved = "";
     const xrow = new Float64Array(d);
     const prow = new Float64Array(M);
+    const before = new Float64Array(M);
     const r2 = new Float64Array(M);
     const throttle = new TextThrottle();
 
@@ -278,6 +288,57 @@ export const IncrementalPredictor = defineBlock({
       } else if (throttle.due(f.t[f.n - 1]!)) describe();
     };
 
+    /** [prediction…, NaN…] of every event, for the versus output while nothing is learnt. */
+    const emitVersus = (o: Frame): void => {
+      const vo = versusOut.frame(o.n);
+      for (let e = 0; e < o.n; e++) {
+        vo.t[e] = o.t[e]!;
+        for (let i = 0; i < M; i++) {
+          vo.v[e * 2 * M + i] = o.v[e * M + i]!;
+          vo.v[e * 2 * M + M + i] = NaN;
+        }
+      }
+      versusOut.emit(vo);
+    };
+
+    /**
+     * One event at a time, to report the fit after every sample learnt and, when `versus` is
+     * read, the prediction made before each sample is learnt.
+     */
+    const learnEach = (f: Frame, o: Frame): void => {
+      const n = f.n;
+      const ft = f.t;
+      const fo = fitOut.frame(n);
+      const vo = versusOut.idle ? null : versusOut.frame(n);
+      const w = 1 + M;
+      let k = 0;
+      const fv = f.v;
+      for (let e = 0; e < n; e++) {
+        for (let i = 0; i < d; i++) xrow[i] = fv[e * d + i]!;
+        if (vo) {
+          model.predict(xrow, before, 1);
+          vo.t[e] = ft[e]!;
+          for (let i = 0; i < M; i++) {
+            vo.v[e * 2 * M + i] = before[i]!;
+            vo.v[e * 2 * M + M + i] = target[i]!;
+          }
+        }
+        const used = model.trainPredict(xrow, target, prow, 1);
+        for (let i = 0; i < M; i++) o.v[e * M + i] = prow[i]!;
+        if (used > 0) {
+          learntSinceSave++;
+          model.r2(r2);
+          fo.t[k] = ft[e]!;
+          fo.v[k * w] = model.samplesSeen();
+          for (let i = 0; i < M; i++) fo.v[k * w + 1 + i] = r2[i]!;
+          k++;
+        }
+      }
+      fo.n = k;
+      fitOut.emit(fo);
+      if (vo) versusOut.emit(vo);
+    };
+
     const onFeatures = (f: Frame): void => {
       const n = f.n;
       const o = out.frame(n);
@@ -285,29 +346,11 @@ export const IncrementalPredictor = defineBlock({
       for (let e = 0; e < n; e++) o.t[e] = ft[e]!;
       if (!hasTarget || paused) {
         model.predict(f.v, o.v, n);
-      } else if (fitOut.idle) {
+        if (!versusOut.idle) emitVersus(o);
+      } else if (fitOut.idle && versusOut.idle) {
         learntSinceSave += model.trainPredict(f.v, target, o.v, n);
       } else {
-        // One event at a time, to report the fit after every sample learnt.
-        const fo = fitOut.frame(n);
-        const w = 1 + M;
-        let k = 0;
-        const fv = f.v;
-        for (let e = 0; e < n; e++) {
-          for (let i = 0; i < d; i++) xrow[i] = fv[e * d + i]!;
-          const used = model.trainPredict(xrow, target, prow, 1);
-          for (let i = 0; i < M; i++) o.v[e * M + i] = prow[i]!;
-          if (used > 0) {
-            learntSinceSave++;
-            model.r2(r2);
-            fo.t[k] = ft[e]!;
-            fo.v[k * w] = model.samplesSeen();
-            for (let i = 0; i < M; i++) fo.v[k * w + 1 + i] = r2[i]!;
-            k++;
-          }
-        }
-        fo.n = k;
-        fitOut.emit(fo);
+        learnEach(f, o);
       }
       out.emit(o);
       if (throttle.due(ft[n - 1]!)) describe();
@@ -385,11 +428,7 @@ export const IncrementalPredictor = defineBlock({
         load: {
           label: "Load model",
           description: `Replace the model by one from a file (default ${defaultFile})`,
-          run(arg) {
-            const file = modelFileArg(arg, defaultFile);
-            loadModelFile(files, file);
-            return `loading ${file}`;
-          },
+          run: (arg) => loadModelAction(files, arg, defaultFile),
         },
         inspect: {
           label: "Inspect",

@@ -809,6 +809,38 @@ export function loadModelFile(h: ModelFileHost, file: string): void {
   );
 }
 
+/** A model file's own text, chosen in the page (the UI's "Load model from file…"). */
+export interface ModelText {
+  /** The chosen file's name, for messages. */
+  name: string;
+  text: string;
+}
+
+const isModelText = (arg: unknown): arg is ModelText =>
+  arg !== null &&
+  typeof arg === "object" &&
+  typeof (arg as { name?: unknown }).name === "string" &&
+  typeof (arg as { text?: unknown }).text === "string";
+
+/**
+ * The `load` action: a file name (default `defaultFile`) is read in the background (a failure
+ * becomes a warning); a model file's text ({ name, text }, a file picked in the page, which the
+ * engine may have no access to) is checked and replaces the model at once, or the action fails
+ * with the reason.
+ */
+export function loadModelAction(h: ModelFileHost, arg: unknown, defaultFile: string): string {
+  if (!isModelText(arg)) {
+    const file = modelFileArg(arg, defaultFile);
+    loadModelFile(h, file);
+    return `loading ${file}`;
+  }
+  const name = arg.name.trim() || "the chosen file";
+  const r = loadModel(arg.text, name, h.expect);
+  const message = `loaded ${name}: ${describeOptions(r.model.options)}`;
+  h.onLoaded(r.model, message);
+  return message;
+}
+
 /** Mean of the defined R² values, for status texts: "R² 0.82", or "R² –". */
 export function formatR2(r2: Float64Array): string {
   let s = 0;

@@ -159,6 +159,52 @@ describe("FilePlayer", () => {
     expect(seek.run("soon")).toMatch(/^seek: give the seconds/);
   });
 
+  test("position: [seconds, duration, row, rows] for every row played, and at once after a seek", async () => {
+    const csv = "t,x\n10,1\n11,2\n12,3\n14,4\n";
+    const h = await player({ File: "r.csv" }, { "r.csv": csv }, { now: 0 });
+    h.start();
+    h.fireOneShot();
+    h.fireOneShot();
+    expect(h.output("position").t).toEqual([0, 1]);
+    expect(h.output("position").v).toEqual([
+      [0, 4, 1, 4],
+      [1, 4, 2, 4],
+    ]);
+    h.clock = 1.5;
+    h.instance.actions!.seek!.run(3.5);
+    expect(h.output("position").t.at(-1)).toBe(1.5);
+    expect(h.output("position").v.at(-1)).toEqual([4, 4, 4, 4]);
+    h.instance.actions!.restart!.run();
+    expect(h.output("position").v.at(-1)).toEqual([0, 4, 1, 4]);
+  });
+
+  test("Speed and Loop change while it plays: the position stays, the rows after it follow", async () => {
+    const csv = "t,x\n0,1\n1,2\n2,3\n3,4\n";
+    const h = await player({ File: "r.csv" }, { "r.csv": csv }, { now: 0 });
+    h.start();
+    h.fireOneShot(); // row 0 at 0
+    h.clock = 0.5;
+    // At half a second into the recording, twice as fast: row 1 (at 1 s) is due 0.25 s later.
+    h.instance.setParam!("Speed", 2);
+    h.fireOneShot();
+    h.fireOneShot();
+    expect(h.output().t).toEqual([0, 0.75, 1.25]);
+    // Loop on before the end: after row 3 (at 1.75) comes row 0 one median interval later.
+    h.instance.setParam!("Loop", true);
+    h.fireOneShot();
+    h.fireOneShot();
+    expect(h.output().t).toEqual([0, 0.75, 1.25, 1.75, 2.25]);
+    expect(h.output().v.flat()).toEqual([1, 2, 3, 4, 1]);
+    expect(h.finished).toBe(false);
+    // Loop off: it ends at the last row.
+    h.instance.setParam!("Loop", false);
+    for (let i = 0; i < 3; i++) h.fireOneShot();
+    expect(h.output().v.flat()).toEqual([1, 2, 3, 4, 1, 2, 3, 4]);
+    expect(h.finished).toBe(true);
+    // Too fast for the engine: refused with the reason, the speed unchanged.
+    expect(() => h.instance.setParam!("Speed", 1e9)).toThrow(/above the fastest the engine paces/);
+  });
+
   test("original timing: after stop and start the remaining rows move by the stopped time", async () => {
     const csv = "t,x\n0,1\n1,2\n2,3\n";
     const h = await player({ File: "r.csv" }, { "r.csv": csv }, { now: 0 });

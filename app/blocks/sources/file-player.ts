@@ -8,6 +8,7 @@ import {
   type BlockContext,
   type BlockInstance,
   type FileReadHandle,
+  type Frame,
   type Resources,
 } from "../../engine";
 import { timerInput } from "../shared/inputs";
@@ -56,7 +57,11 @@ export const FilePlayer = defineBlock({
     "loop begins one median interval after the last row), otherwise it stops and reports that " +
     "it finished (a headless run ends when all its finite sources have). Empty lines and lines " +
     "starting with `#` are skipped; only the time column and the played columns must be " +
-    "numbers (NaN and inf are accepted).",
+    "numbers (NaN and inf are accepted). `Speed` and `Loop` change while it plays. The " +
+    "`position` output (for the panel's Player view; computed only while something reads it) " +
+    "carries, for every row played and after a seek or a restart, [seconds from the first row, " +
+    "the recording's duration in seconds (NaN without a time column), row number (1-based), " +
+    "rows in the file (NaN while a big file is still being read)].",
   params: z.strictObject({
     File: z
       .string()
@@ -111,6 +116,7 @@ export const FilePlayer = defineBlock({
         "Playback speed factor for original timing (2 plays twice as fast); unused with a timer input",
       ),
   }),
+  live: ["Speed", "Loop"],
   legacyParams(args) {
     const path = args[0]?.trim() ?? "";
     if (args.length !== 1 || path === "") {
@@ -123,10 +129,12 @@ export const FilePlayer = defineBlock({
   },
   legacyForm: "[path]: the file to play",
   inputs: { min: 0, max: 1, labels: ["timer"] },
+  outputs: ["out", "position"],
   finite: (p) => !p.Loop,
-  views: ["scope"],
+  views: ["player", "scope"],
   panel:
-    "Scope of the played columns, the row position, and restart/pause/resume buttons; seek to a time (seconds) with the Seek action.",
+    "Player: a seek bar with the position and the duration, restart, pause and resume, speed " +
+    "and loop; a scope of the played columns.",
   async create(ctx, p) {
     const timed = ctx.inputs.length === 1;
     if (timed) timerInput(ctx, 0);
@@ -339,6 +347,7 @@ function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): Blo
   if (first === 0) throw new BlockConfigError(`'${p.File}' has a header but no data rows`, "File");
   let span = 0;
   let t0 = 0;
+  let median = NaN;
   if (!timed) {
     if (!src.hasTimes) {
       throw new BlockConfigError(
@@ -368,7 +377,7 @@ function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): Blo
     }
     dts.sort();
     const m = dts.length;
-    const median = m % 2 === 1 ? dts[(m - 1) / 2]! : (dts[m / 2 - 1]! + dts[m / 2]!) / 2;
+    median = m % 2 === 1 ? dts[(m - 1) / 2]! : (dts[m / 2 - 1]! + dts[m / 2]!) / 2;
     if (!(median > 0)) {
       throw new BlockConfigError(
         `the median interval between rows of '${p.File}' is 0 (repeated times); original ` +
@@ -377,29 +386,21 @@ function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): Blo
       );
     }
     const rowHz = p.Speed / median;
-    if (rowHz > MAX_TIMER_HZ) {
-      const fileHz = Number((1 / median).toPrecision(6));
-      throw new BlockConfigError(
-        p.Speed !== 1
-          ? `at Speed ${p.Speed} the rows of '${p.File}' (${fileHz} Hz) would play at ` +
-              `${Number(rowHz.toPrecision(6))} Hz, above the fastest the engine paces, ` +
-              `${MAX_TIMER_HZ} Hz: lower Speed`
-          : `the rows of '${p.File}' come at ${fileHz} Hz, above the fastest the engine paces, ` +
-              `${MAX_TIMER_HZ} Hz: play it with a timer input (one row per tick) or resample it`,
-        p.Speed !== 1 ? "Speed" : "File",
-      );
-    }
+    const tooFast = speedProblem(p.Speed, median, p.File);
+    if (tooFast !== undefined)
+      throw new BlockConfigError(tooFast, p.Speed !== 1 ? "Speed" : "File");
     t0 = src.time(0);
     // Only a loop needs the last row (read from the file's end when it streams).
     if (p.Loop) span = src.lastTime() - t0 + median;
     if (ctx.declaredRate === undefined) ctx.setDesiredRate(rowHz);
   }
-  const speed = p.Speed;
-  const loop = p.Loop;
+  let speed = p.Speed;
+  let loop = p.Loop;
   const out = ctx.output(vectorShape(c), undefined, {
     ...(src.labels ? { labels: src.labels } : {}),
     ...(src.unit ? { unit: src.unit } : {}),
   });
+  const position = playPosition(ctx, src);
 
   let row = 0;
   let loops = 0;
@@ -493,9 +494,11 @@ function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): Blo
       if (n > 0) {
         const o = out.frame(n);
         const ov = o.v;
+        const po = position.frame(n);
         for (let e = 0; e < n; e++) {
           o.t[e] = dueTime(row, loops);
           src.copy(row, ov, e * c);
+          if (po) position.put(po, e, o.t[e]!, row);
           if (!advance()) {
             ended = true;
             o.n = e + 1;
@@ -504,6 +507,7 @@ function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): Blo
         }
         src.release(row);
         out.emit(o);
+        if (po) position.emit(po, o.n);
       }
       if (ended) {
         finish();
@@ -555,6 +559,7 @@ function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): Blo
     if (!timed && started) base = ctx.now() - (src.time(r) - t0 + loops * span) / speed;
     describe();
     schedule();
+    position.now(row);
     return `at ${fmtSeconds(src.time(r) - src.time(0))} s (row ${r + 1})`;
   };
 
@@ -568,6 +573,27 @@ function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): Blo
     if (!timed && started) base = ctx.now();
     describe();
     schedule();
+    position.now(row);
+  };
+
+  /** Speed while playing: the position stays where it is, the rows after it come faster. */
+  const setSpeed = (v: number): void => {
+    if (!timed) {
+      const problem = speedProblem(v, median, p.File);
+      if (problem !== undefined) throw new Error(problem);
+      const anchor = paused ? pausedAt : started ? ctx.now() : stoppedAt;
+      if (!Number.isNaN(base) && !Number.isNaN(anchor)) {
+        base = anchor - ((anchor - base) * speed) / v;
+      }
+    }
+    speed = v;
+    schedule();
+  };
+  /** Loop while playing: the end of the file starts it again (or, turned off, ends it). */
+  const setLoop = (v: boolean): void => {
+    if (v && !timed && span === 0) span = src.lastTime() - t0 + median;
+    loop = v;
+    if (!v) schedule();
   };
   describe();
 
@@ -598,10 +624,12 @@ function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): Blo
       const o = out.frame(n);
       const ov = o.v;
       const ft = f.t;
+      const po = position.frame(n);
       let ended = false;
       for (let e = 0; e < n; e++) {
         o.t[e] = ft[e]!;
         src.copy(row, ov, e * c);
+        if (po) position.put(po, e, ft[e]!, row);
         if (!advance()) {
           ended = true;
           o.n = e + 1;
@@ -610,6 +638,7 @@ function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): Blo
       }
       src.release(row);
       out.emit(o);
+      if (po) position.emit(po, o.n);
       if (ended) finish();
       else if (throttle.due(ft[o.n - 1]!)) describe();
     },
@@ -619,6 +648,10 @@ function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): Blo
     },
     dispose() {
       src.close();
+    },
+    setParam(name, value) {
+      if (name === "Speed") setSpeed(value as number);
+      else if (name === "Loop") setLoop(value as boolean);
     },
     actions: {
       restart: {
@@ -658,6 +691,66 @@ function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): Blo
           return `resumed at row ${row}`;
         },
       },
+    },
+  };
+}
+
+/** Why `speed` cannot play rows `median` seconds apart (faster than the engine paces), or undefined. */
+function speedProblem(speed: number, median: number, file: string): string | undefined {
+  const rowHz = speed / median;
+  if (!(rowHz > MAX_TIMER_HZ)) return undefined;
+  const fileHz = Number((1 / median).toPrecision(6));
+  return speed !== 1
+    ? `at Speed ${speed} the rows of '${file}' (${fileHz} Hz) would play at ` +
+        `${Number(rowHz.toPrecision(6))} Hz, above the fastest the engine paces, ` +
+        `${MAX_TIMER_HZ} Hz: lower Speed`
+    : `the rows of '${file}' come at ${fileHz} Hz, above the fastest the engine paces, ` +
+        `${MAX_TIMER_HZ} Hz: play it with a timer input (one row per tick) or resample it`;
+}
+
+/** Row of a played recording, for the `position` output: seconds, duration, row, rows. */
+interface PlayPosition {
+  /** A frame for `n` positions, or null when nothing reads the output. */
+  frame(n: number): Frame | null;
+  put(f: Frame, e: number, t: number, row: number): void;
+  emit(f: Frame, n: number): void;
+  /** Emits the position of `row` (the next to play) now: after a seek or a restart. */
+  now(row: number): void;
+}
+
+function playPosition(ctx: BlockContext, src: RowSource): PlayPosition {
+  const port = ctx.output(vectorShape(4), "position", {
+    labels: ["seconds", "duration", "row", "rows"],
+  });
+  const first = src.hasTimes ? src.time(0) : NaN;
+  let duration = NaN;
+  if (src.hasTimes) {
+    try {
+      duration = src.lastTime() - first;
+    } catch {
+      // A streamed file whose end cannot be read yet: the duration stays unknown.
+    }
+  }
+  const put = (f: Frame, e: number, t: number, row: number): void => {
+    f.t[e] = t;
+    const v = f.v;
+    v[e * 4] = src.hasTimes ? src.time(row) - first : NaN;
+    v[e * 4 + 1] = duration;
+    v[e * 4 + 2] = row + 1;
+    v[e * 4 + 3] = src.total ?? NaN;
+  };
+  return {
+    frame: (n) => (port.idle ? null : port.frame(n)),
+    put,
+    emit(f, n) {
+      f.n = n;
+      port.emit(f);
+    },
+    now(row) {
+      if (port.idle || !(src.fill(row + 1) > row)) return;
+      const f = port.frame(1);
+      put(f, 0, ctx.now(), row);
+      port.emit(f);
     },
   };
 }

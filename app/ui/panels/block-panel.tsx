@@ -23,9 +23,11 @@ import { HEATMAP_DEFAULTS, Heatmap, type HeatmapSettings } from "./heatmap";
 import { LabelDisplay } from "./labels";
 import { SCOPE_DEFAULTS, Scope, type ScopeSettings } from "./scope";
 import { SPIDER_DEFAULTS, SpiderPlot, type SpiderSettings } from "./spider";
+import { PlayerView } from "./player-view";
 import { StatusView, useStatusRecorder } from "./status";
 import type { OutputInfo } from "./view-props";
 import "./panels.css";
+import { TrainingView } from "./training-view";
 
 export interface BlockPanelProps {
   block: BlockInfo;
@@ -38,7 +40,7 @@ export interface BlockPanelProps {
   onEditStatic?: (param: string, value: unknown) => Promise<SetResult>;
 }
 
-type DataView = "scope" | "spider" | "heatmap" | "label";
+type DataView = "scope" | "spider" | "heatmap" | "label" | "training" | "player";
 type Tab = DataView | "params" | "status";
 
 const TAB_TITLE: Record<Tab, string> = {
@@ -49,9 +51,11 @@ const TAB_TITLE: Record<Tab, string> = {
   params: "Params",
   status: "Status",
 };
-const DATA_VIEWS: readonly string[] = ["scope", "spider", "heatmap", "label"];
+const DATA_VIEWS: readonly string[] = ["scope", "spider", "heatmap", "label", "training", "player"];
 
 interface Settings {
+  training: "Training",
+  player: "Player",
   scope: ScopeSettings;
   spider: SpiderSettings;
   heatmap: HeatmapSettings;
@@ -154,6 +158,10 @@ export function BlockPanel({
         tools={tools}
         block={block}
         output={output}
+  } else if (tab === "training") {
+    body = <TrainingView block={block} active={active} />;
+  } else if (tab === "player") {
+    body = <PlayerView block={block} active={active} />;
         active={active}
         settings={settings.scope}
         onSettings={patch("scope")}

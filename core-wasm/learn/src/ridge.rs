@@ -698,7 +698,7 @@ impl Ridge {
                 return Err(rd.bad(k, st[k], "a weight or sum of squares >= 0"));
             }
         }
-        // Rebuild the factor and the weights from the normal equations.
+        // Rebuild the factor and check the weights against the normal equations.
         let mut r = vec![0.0; p * p];
         if !linalg::cholesky_upper(s, lam, pen, &mut r, p) {
             return Err(LearnError::NotPositiveDefinite);
@@ -742,7 +742,9 @@ impl Ridge {
         self.s.copy_from_slice(s);
         self.c.copy_from_slice(c);
         self.r = r;
-        self.w = wn;
+        // The saved weights themselves (they agree with the normal equations, checked above):
+        // a loaded model predicts exactly what the saved one did, not within rounding.
+        self.w.copy_from_slice(w);
         self.stats.weight = st[0];
         self.stats.mean.copy_from_slice(&st[1..1 + m]);
         self.stats.m2.copy_from_slice(&st[1 + m..1 + 2 * m]);
