@@ -169,4 +169,29 @@ describe.skipIf(!haveChromium)("live params on mosaic serve (two tabs)", () => {
     expect([...a.errors, ...b.errors, ...c.errors]).toEqual([]);
     await c.close();
   }, 60_000);
+  test("edit mode: Take live values sets them in the text; its Save clears the markers", async () => {
+    await setValue(b.page, 42);
+    await expectShown(a.page, 42, true);
+    const { page } = a;
+    await page.click('header button:has-text("Edit")');
+    // The inspector says what the engine runs that the text lacks.
+    await page.click('.edit-canvas .block-node[data-block="Amplification"]');
+    await page.waitForSelector(".inspector__running");
+    // (100 after the write-back above; 5 when this test runs alone)
+    expect(await page.textContent(".inspector__running")).toMatch(
+      /Value = 42 \(the text: (100|5)\)/,
+    );
+    await page.screenshot({ path: artifact("live-params-edit-mode.png") });
+    await page.click(".editor__take-live");
+    await page.waitForSelector(".editor__take-live", { state: "detached" });
+    expect(await page.getAttribute(".editor", "data-dirty")).toBe("false");
+    const text = await downloadText(page, () =>
+      page.click('.editor__bar button:has-text("Save…")'),
+    );
+    expect(text).toBe(
+      DEMO.replace("Operation: multiply, Value: 5 }", "Operation: multiply, Value: 42 }"),
+    );
+    await expectShown(b.page, 42, false);
+    expect([...a.errors, ...b.errors]).toEqual([]);
+  }, 60_000);
 });

@@ -14,6 +14,7 @@ import { download } from "../graph/block-table";
 import type { SetResult } from "../forms/params-form";
 import { EditCanvas } from "./edit-canvas";
 import { Inspector } from "./inspector";
+import { savedLiveValues, TakeLiveValues } from "./live-values-bar";
 import { typeIndex, type EditIssue } from "./model";
 import { Palette } from "./palette";
 import { TextView } from "./text-view";
@@ -165,6 +166,8 @@ export function Editor(props: EditorProps): ReactNode {
     const name = ed.file.split("/").pop() || "pipeline.yaml";
     download(name, ed.text);
     onNotify(`Saved ${name} (downloaded)`);
+    // The text that runs: the live values it has are the file's now (their markers clear).
+    if (!dirty && graph !== undefined) void savedLiveValues(client, ed.text, ed.blocks);
   };
 
   const pickTemplate = async (file: string): Promise<void> => {
@@ -272,6 +275,14 @@ export function Editor(props: EditorProps): ReactNode {
         >
           Delete
         </button>
+        <TakeLiveValues
+          ed={ed}
+          onNotify={onNotify}
+          // The running pipeline has the values: a text that ran before still does.
+          onTaken={() => {
+            if (!dirty) setApplied((a) => ({ ...a, text: ed.textNow() }));
+          }}
+        />
         <span className="toolbar__spacer" />
         <span className="editor__state" role="status" aria-live="polite">
           {applying

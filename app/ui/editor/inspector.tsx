@@ -5,7 +5,9 @@
  */
 import { useEffect, useId, useState, type ReactNode } from "react";
 import type { BlockInfo, BlockTypeInfo } from "../../engine/protocol";
+import { useLiveBlock } from "../client/hooks";
 import { ParamsForm, type SetResult } from "../forms/params-form";
+import { changedParams, missingFromText } from "./live-values";
 import type { EditBlock, EditIssue } from "./model";
 
 export interface InspectorProps {
@@ -162,6 +164,7 @@ export function Inspector(props: InspectorProps): ReactNode {
         onCommit={(s) => props.onPath(s === "" ? undefined : s)}
       />
       <h4 className="inspector__params-title">Params</h4>
+      <RunningValues block={b} running={props.runningBlock} />
       {t ? (
         <ParamsForm
           block={info}
@@ -173,5 +176,40 @@ export function Inspector(props: InspectorProps): ReactNode {
         <p className="inspector__hint">Unknown type: no params form.</p>
       )}
     </section>
+  );
+}
+
+/**
+ * The live values the engine runs this block with that the text lacks (changed since loaded,
+ * from any tab): the form below shows the text's values (issue 17, defect 1).
+ */
+function RunningValues({
+  block,
+  running,
+}: {
+  block: EditBlock;
+  running: BlockInfo | undefined;
+}): ReactNode {
+  const now = useLiveBlock(running);
+  if (now === undefined) return null;
+  const changes = changedParams(now).map((param) => ({
+    block: block.name,
+    param,
+    value: now.params[param],
+    file: now.fileParams?.[param],
+  }));
+  const missing = missingFromText(changes, [block]);
+  if (missing.length === 0) return null;
+  return (
+    <p className="inspector__running" role="note" data-running-values={missing.length}>
+      The engine runs{" "}
+      {missing
+        .map(
+          (c) =>
+            `${c.param} = ${JSON.stringify(c.value)} (the text: ${JSON.stringify(block.params[c.param] ?? null)})`,
+        )
+        .join(", ")}
+      , changed since loaded: <em>Take live values</em> sets them in the text.
+    </p>
   );
 }

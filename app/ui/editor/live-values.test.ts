@@ -1,6 +1,16 @@
 import { describe, expect, test } from "vitest";
 import type { BlockInfo, GraphInfo } from "../../engine/protocol";
-import { changedParams, describeChanges, liveChanges, writeLiveValues } from "./live-values";
+import { parseDocumentText } from "./doc";
+import {
+  applyLiveValues,
+  changedParams,
+  describeChanges,
+  liveChanges,
+  missingFromText,
+  presentInText,
+  writeLiveValues,
+} from "./live-values";
+import { readBlocks } from "./model";
 
 const block = (b: Partial<BlockInfo> & { name: string }): BlockInfo => ({
   type: "Function",
@@ -108,5 +118,36 @@ describe("live values against the file", () => {
     expect(describeChanges([c("A", 1), c("B", [1, 2]), c("C", 3), c("D", 4)], 2)).toBe(
       "A.Value = 1, B.Value = [1,2] and 2 more",
     );
+  });
+});
+
+describe("live values against the editor's text", () => {
+  test("the changes the text has, and those it lacks", () => {
+    const { blocks } = readBlocks(DEMO.replace("Value: 5 }", "Value: 100 }"));
+    const changes = [
+      { block: "Amplification", param: "Value", value: 100, file: 5 },
+      { block: "Filter", param: "Numerator", value: [0.5, 0.5], file: [1] },
+      { block: "Filter", param: "Denominator", value: [2], file: [1] },
+      { block: "Gone", param: "Value", value: 1, file: 0 },
+    ];
+    expect(presentInText(changes, blocks).map((c) => `${c.block}.${c.param}`)).toEqual([
+      "Amplification.Value",
+      "Filter.Numerator",
+    ]);
+    expect(missingFromText(changes, blocks).map((c) => `${c.block}.${c.param}`)).toEqual([
+      "Filter.Denominator",
+      "Gone.Value",
+    ]);
+  });
+
+  test("applyLiveValues edits a document in place (the editor's undoable edit)", () => {
+    const doc = parseDocumentText(DEMO, "demo.yaml");
+    const r = applyLiveValues(doc, [
+      { block: "Amplification", param: "Value", value: 100, file: 5 },
+      { block: "Legacy", param: "Value", value: 4, file: 3 },
+    ]);
+    expect(r.written).toHaveLength(1);
+    expect(r.skipped).toHaveLength(1);
+    expect(doc.toString()).toBe(DEMO.replace("Value: 5 }", "Value: 100 }"));
   });
 });

@@ -6,7 +6,8 @@
  */
 import type { BlockInfo, GraphInfo } from "../../engine/protocol";
 import { deepEqual } from "../forms/schema";
-import { parseDocumentText } from "./doc";
+import { parseDocumentText, type EditableDocument } from "./doc";
+import type { EditBlock } from "./model";
 
 /** One live param whose engine value differs from the file's. */
 export interface LiveChange {
@@ -57,6 +58,15 @@ export function writeLiveValues(
   changes: readonly LiveChange[],
 ): WriteBack {
   const doc = parseDocumentText(text, file);
+  const r = applyLiveValues(doc, changes);
+  return { text: doc.toString(), ...r };
+}
+
+/** Sets each change's value in `doc` (see writeLiveValues); says which were written. */
+export function applyLiveValues(
+  doc: EditableDocument,
+  changes: readonly LiveChange[],
+): Omit<WriteBack, "text"> {
   const written: LiveChange[] = [];
   const skipped: WriteBack["skipped"] = [];
   for (const change of changes) {
@@ -67,7 +77,29 @@ export function writeLiveValues(
       skipped.push({ change, reason: (e as Error).message });
     }
   }
-  return { text: doc.toString(), written, skipped };
+  return { written, skipped };
+}
+
+/** Whether the text's block (as the editor reads it) has the change's value. */
+function hasValue(blocks: readonly EditBlock[], c: LiveChange): boolean {
+  const b = blocks.find((x) => x.name === c.block);
+  return b !== undefined && deepEqual(b.params[c.param], c.value);
+}
+
+/** The changes whose value the text lacks (the editor offers to take them into it). */
+export function missingFromText(
+  changes: readonly LiveChange[],
+  blocks: readonly EditBlock[],
+): LiveChange[] {
+  return changes.filter((c) => !hasValue(blocks, c));
+}
+
+/** The changes whose value the text has (saving it writes them to the file). */
+export function presentInText(
+  changes: readonly LiveChange[],
+  blocks: readonly EditBlock[],
+): LiveChange[] {
+  return changes.filter((c) => hasValue(blocks, c));
 }
 
 /** "Amplification.Value = 100, Emg.Gain = 2" (at most `max` named, then "and N more"). */
