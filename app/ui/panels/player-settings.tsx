@@ -1,4 +1,7 @@
-/** A FilePlayer's live params in its Player view: Speed (presets or a number) and Loop. */
+/**
+ * A FilePlayer's live params in its Player view: Speed (presets, or the file's value) and Loop,
+ * shown at once and put back when the engine refuses them.
+ */
 import { useState, type ReactNode } from "react";
 import type { BlockInfo } from "../../engine/protocol";
 import { useEngine } from "../client/hooks";
@@ -29,7 +32,9 @@ export function PlayerSettings({
           value={String(speed)}
           onChange={(e) => {
             const v = Number(e.target.value);
-            void set("Speed", v).then((ok) => ok && setSpeed(v));
+            const was = speed;
+            setSpeed(v);
+            void set("Speed", v).then((ok) => ok || setSpeed(was));
           }}
         >
           {options.map((s) => (
@@ -45,7 +50,8 @@ export function PlayerSettings({
           checked={loop}
           onChange={(e) => {
             const v = e.target.checked;
-            void set("Loop", v).then((ok) => ok && setLoop(v));
+            setLoop(v);
+            void set("Loop", v).then((ok) => ok || setLoop(!v));
           }}
         />
         Loop

@@ -52,13 +52,13 @@ export function PlayerView({ block, active }: { block: BlockInfo; active: boolea
       <SeekBar pos={pos} onSeek={(s) => void act("seek", s)} />
       <div className="mp-toolbar">
         <button type="button" className="mp-btn" onClick={() => void act("restart")}>
-          ⏮ Restart
+          Restart
         </button>
         <button type="button" className="mp-btn" onClick={() => void act("pause")}>
-          ⏸ Pause
+          Pause
         </button>
         <button type="button" className="mp-btn" onClick={() => void act("resume")}>
-          ▶ Resume
+          Resume
         </button>
       </div>
       <PlayerSettings block={block} onReply={setReply} />
