@@ -22,6 +22,7 @@ const TYPES = [
   "validate",
   "record-start",
   "record-stop",
+  "params-written",
   "start",
   "stop",
   "catalog",
@@ -72,6 +73,10 @@ const message = fc.record(
     port: field,
     maxRate: field,
     extra: field,
+    values: fc.oneof(
+      field,
+      fc.array(fc.record({ block: field, param: field, value: field }), { maxLength: 3 }),
+    ),
   },
   { requiredKeys: ["type"] },
 );
