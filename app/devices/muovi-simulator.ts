@@ -23,6 +23,7 @@
  * Pure Node (node:net); used by the tests and by `mosaic simulate syncstation|muovi`.
  */
 import { createServer, connect, type AddressInfo, type Server, type Socket } from "node:net";
+import { PacedSampleStream } from "./paced-sample-stream";
 
 /** The probes' EMG rate, channels per Muovi on the wire, and the SyncStation's own channels. */
 export const MUOVI_RATE = 2000;
@@ -133,85 +134,18 @@ function encode(
   return b;
 }
 
-/** One streaming session on a socket: samples at 2 kHz from the wall clock, with faults. */
-class Stream {
-  private k = 0;
-  private sent = 0;
-  private t0 = 0;
-  private timer: NodeJS.Timeout | undefined;
-  private pendingInject: Buffer[] = [];
-  private pendingSkip = 0;
-  private pendingTruncate = false;
-
-  constructor(
-    private readonly socket: Socket,
-    readonly channels: number,
-    private readonly value: (ch: number, k: number) => number,
-    private readonly onEnd: () => void,
-  ) {}
-
-  get samples(): number {
-    return this.k;
-  }
-
-  start(): void {
-    this.stop();
-    this.k = 0;
-    this.sent = 0;
-    this.t0 = performance.now();
-    this.timer = setInterval(() => this.pump(), 5);
-  }
-
-  stop(): void {
-    if (this.timer) clearInterval(this.timer);
-    this.timer = undefined;
-  }
-
-  get running(): boolean {
-    return this.timer !== undefined;
-  }
-
-  inject(bytes: Uint8Array): void {
-    this.pendingInject.push(Buffer.from(bytes));
-  }
-
-  skip(n: number): void {
-    this.pendingSkip += n;
-  }
-
-  truncate(): void {
-    this.pendingTruncate = true;
-  }
-
-  private pump(): void {
-    const s = this.socket;
-    if (s.destroyed) {
-      this.stop();
-      return;
-    }
-    const due = Math.floor(((performance.now() - this.t0) / 1000) * MUOVI_RATE) - this.sent;
-    if (due < PACKET_SAMPLES) return;
-    const n = due - (due % PACKET_SAMPLES);
-    this.sent += n;
-    if (this.pendingTruncate) {
-      this.pendingTruncate = false;
-      const half = encode(this.k, 1, this.channels, this.value).subarray(0, this.channels);
-      s.write(half, () => s.destroy());
-      this.stop();
-      this.onEnd();
-      return;
-    }
-    if (this.pendingSkip > 0) {
-      this.k += this.pendingSkip;
-      this.pendingSkip = 0;
-    }
-    const half = Math.floor(n / 2);
-    const parts: Buffer[] = [encode(this.k, half, this.channels, this.value)];
-    parts.push(...this.pendingInject.splice(0));
-    parts.push(encode(this.k + half, n - half, this.channels, this.value));
-    this.k += n;
-    if (s.writableLength < MAX_UNREAD) s.write(Buffer.concat(parts));
-  }
+/** A stream of `channels` int16 big-endian values per sample at 2 kHz, in packets of 20 samples. */
+function muoviStream(
+  socket: Socket,
+  channels: number,
+  value: (ch: number, k: number) => number,
+): PacedSampleStream {
+  const source = {
+    rate: MUOVI_RATE,
+    packetSamples: PACKET_SAMPLES,
+    encode: (k0: number, n: number) => encode(k0, n, channels, value),
+  };
+  return new PacedSampleStream(socket, source, { pumpMs: 5, maxUnread: MAX_UNREAD });
 }
 
 export interface SyncStationSimulatorOptions {
@@ -234,7 +168,7 @@ export class SyncStationSimulator {
   readonly refused: string[] = [];
   /** Stop commands received. */
   stops = 0;
-  private readonly streams = new Set<Stream>();
+  private readonly streams = new Set<PacedSampleStream>();
   private readonly sockets = new Set<Socket>();
   private readonly log: (line: string) => void;
 
@@ -275,7 +209,7 @@ export class SyncStationSimulator {
     s.setNoDelay(true);
     this.sockets.add(s);
     this.log(`client connected from ${s.remoteAddress}:${s.remotePort}`);
-    let stream: Stream | undefined;
+    let stream: PacedSampleStream | undefined;
     let pending = Buffer.alloc(0);
     const end = () => {
       stream?.stop();
@@ -308,31 +242,26 @@ export class SyncStationSimulator {
           continue;
         }
         this.commands.push(r.request);
-        stream = this.streamFor(s, r.request, end);
+        stream = this.streamFor(s, r.request);
         this.streams.add(stream);
         stream.start();
       }
     });
   }
 
-  private streamFor(s: Socket, req: SyncStationRequest, end: () => void): Stream {
+  private streamFor(s: Socket, req: SyncStationRequest): PacedSampleStream {
     const slots = req.probes.map((p) => p.slot).sort((a, b) => a - b);
     const channels = slots.length * MUOVI_WIRE_CHANNELS + SYNCSTATION_CHANNELS;
     const seed = this.seed;
     this.log(
       `start command: Muovi slot${slots.length === 1 ? "" : "s"} ${slots.join(", ")}; streaming ${channels} channels at ${MUOVI_RATE} Hz`,
     );
-    return new Stream(
-      s,
-      channels,
-      (ch, k) => {
-        const probe = Math.floor(ch / MUOVI_WIRE_CHANNELS);
-        return probe < slots.length
-          ? muoviRaw(seed, slots[probe]!, ch % MUOVI_WIRE_CHANNELS, k)
-          : syncStationRaw(seed, ch - slots.length * MUOVI_WIRE_CHANNELS, k);
-      },
-      end,
-    );
+    return muoviStream(s, channels, (ch, k) => {
+      const probe = Math.floor(ch / MUOVI_WIRE_CHANNELS);
+      return probe < slots.length
+        ? muoviRaw(seed, slots[probe]!, ch % MUOVI_WIRE_CHANNELS, k)
+        : syncStationRaw(seed, ch - slots.length * MUOVI_WIRE_CHANNELS, k);
+    });
   }
 
   /** Every client's connection drops (as a SyncStation switched off and on). */
@@ -382,7 +311,7 @@ export class MuoviProbeSimulator {
   /** Connections made. */
   connections = 0;
   private socket: Socket | undefined;
-  private stream: Stream | undefined;
+  private stream: PacedSampleStream | undefined;
   private closed = false;
   private retryTimer: NodeJS.Timeout | undefined;
   private readonly log: (line: string) => void;
@@ -442,11 +371,8 @@ export class MuoviProbeSimulator {
     }
     this.log(`command ${byte}: streaming ${MUOVI_WIRE_CHANNELS} channels at ${MUOVI_RATE} Hz`);
     this.stream?.stop();
-    this.stream = new Stream(
-      s,
-      MUOVI_WIRE_CHANNELS,
-      (ch, k) => muoviRaw(this.seed, this.slot, ch, k),
-      () => {},
+    this.stream = muoviStream(s, MUOVI_WIRE_CHANNELS, (ch, k) =>
+      muoviRaw(this.seed, this.slot, ch, k),
     );
     this.stream.start();
   }

@@ -21,6 +21,7 @@
  */
 import { createServer, type AddressInfo, type Server, type Socket } from "node:net";
 import { crc8Table } from "./muovi-simulator";
+import { PacedSampleStream, type PacedSource } from "./paced-sample-stream";
 
 export const QUATTROCENTO_PORT = 23456;
 export const QUATTROCENTO_RATES = [512, 2048, 5120, 10240] as const;
@@ -135,88 +136,24 @@ function encode(seed: number, req: QuattrocentoRequest, k0: number, n: number): 
   return b;
 }
 
-/** One streaming session on a socket: samples at the commanded rate from the wall clock. */
-class Stream {
-  private k = 0;
-  private sent = 0;
-  private t0 = 0;
-  private timer: NodeJS.Timeout | undefined;
-  private pendingInject: Buffer[] = [];
-  private pendingSkip = 0;
-  private pendingTruncate = false;
-  /** Samples not sent because the client did not read (MAX_UNREAD). */
-  dropped = 0;
-
+/** The samples of a stream whose request may change (REC_ON) without restarting it. */
+class QuattrocentoSource implements PacedSource {
+  readonly packetSamples = 1;
   constructor(
-    private readonly socket: Socket,
     readonly seed: number,
     public req: QuattrocentoRequest,
   ) {}
 
-  get samples(): number {
-    return this.k;
+  get rate(): number {
+    return this.req.rate;
   }
 
-  start(): void {
-    this.stop();
-    this.k = 0;
-    this.sent = 0;
-    this.t0 = performance.now();
-    this.timer = setInterval(() => this.pump(), 5);
-  }
-
-  stop(): void {
-    if (this.timer) clearInterval(this.timer);
-    this.timer = undefined;
-  }
-
-  get running(): boolean {
-    return this.timer !== undefined;
-  }
-
-  inject(bytes: Uint8Array): void {
-    this.pendingInject.push(Buffer.from(bytes));
-  }
-
-  skip(n: number): void {
-    this.pendingSkip += n;
-  }
-
-  truncate(): void {
-    this.pendingTruncate = true;
-  }
-
-  private pump(): void {
-    const s = this.socket;
-    if (s.destroyed) {
-      this.stop();
-      return;
-    }
-    const n = Math.floor(((performance.now() - this.t0) / 1000) * this.req.rate) - this.sent;
-    if (n < 1) return;
-    this.sent += n;
-    if (this.pendingTruncate) {
-      this.pendingTruncate = false;
-      const half = encode(this.seed, this.req, this.k, 1).subarray(0, this.req.channels);
-      this.stop();
-      s.write(half, () => s.destroy());
-      return;
-    }
-    this.k += this.pendingSkip;
-    this.pendingSkip = 0;
-    if (s.writableLength > MAX_UNREAD) {
-      this.k += n;
-      this.dropped += n;
-      return;
-    }
-    const half = Math.floor(n / 2);
-    const parts: Buffer[] = [encode(this.seed, this.req, this.k, half)];
-    parts.push(...this.pendingInject.splice(0));
-    parts.push(encode(this.seed, this.req, this.k + half, n - half));
-    this.k += n;
-    s.write(Buffer.concat(parts));
+  encode(k0: number, n: number): Buffer {
+    return encode(this.seed, this.req, k0, n);
   }
 }
+
+type Stream = PacedSampleStream<QuattrocentoSource>;
 
 export interface QuattrocentoSimulatorOptions {
   /** Address to listen on (default 127.0.0.1). */
@@ -320,16 +257,20 @@ export class QuattrocentoSimulator {
       this.log("acquisition off: streaming stopped");
       return stream;
     }
-    const same = stream?.running && stream.req.rate === req.rate && stream.req.nch === req.nch;
+    const same =
+      stream?.running && stream.source.req.rate === req.rate && stream.source.req.nch === req.nch;
     this.commands.push(req);
     if (same) {
-      stream!.req = req;
+      stream!.source.req = req;
       this.log(`acquisition on, same rate and channels (REC_ON ${req.recording ? 1 : 0})`);
       return stream;
     }
     stream?.stop();
     if (stream) this.streams.delete(stream);
-    const next = new Stream(s, this.seed, req);
+    const next = new PacedSampleStream(s, new QuattrocentoSource(this.seed, req), {
+      pumpMs: 5,
+      maxUnread: MAX_UNREAD,
+    });
     this.streams.add(next);
     next.start();
     this.log(

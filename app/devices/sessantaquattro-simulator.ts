@@ -21,6 +21,7 @@
  * Pure Node (node:net); used by the tests and by `mosaic simulate sessantaquattro`.
  */
 import { connect, type Socket } from "node:net";
+import { PacedSampleStream } from "./paced-sample-stream";
 
 /** The port the device connects to by default, and what FSAMP and NCH select. */
 export const SESSANTAQUATTRO_PORT = 45454;
@@ -178,15 +179,9 @@ export class SessantaquattroSimulator {
   /** The configuration streaming now (or last). */
   config: SimConfig | undefined;
   private socket: Socket | undefined;
-  private timer: NodeJS.Timeout | undefined;
+  private stream: PacedSampleStream | undefined;
   private retryTimer: NodeJS.Timeout | undefined;
   private closed = false;
-  private k = 0;
-  private sent = 0;
-  private t0 = 0;
-  private pendingInject: Buffer[] = [];
-  private pendingSkip = 0;
-  private pendingTruncate = false;
   private readonly log: (line: string) => void;
 
   constructor(private readonly o: SessantaquattroSimulatorOptions) {
@@ -202,17 +197,17 @@ export class SessantaquattroSimulator {
   }
 
   get streaming(): boolean {
-    return this.timer !== undefined;
+    return this.stream?.running ?? false;
   }
 
   /** Samples sent (and skipped) since the last start word. */
   get samples(): number {
-    return this.k;
+    return this.stream?.samples ?? 0;
   }
 
   /** When the last start word came (performance.now(), ms): samples never run ahead of it. */
   get startedAt(): number {
-    return this.t0;
+    return this.stream?.startedAt ?? 0;
   }
 
   private connect(): void {
@@ -266,39 +261,21 @@ export class SessantaquattroSimulator {
   private startStream(s: Socket, c: SimConfig): void {
     this.stopStream();
     this.config = c;
-    this.k = 0;
-    this.sent = 0;
-    this.t0 = performance.now();
-    this.timer = setInterval(() => this.pump(s, c), PACKET_MS / 2);
+    const seed = this.seed;
+    const source = {
+      rate: c.rate,
+      packetSamples: Math.max(1, Math.round((c.rate * PACKET_MS) / 1000)),
+      encode: (k0: number, n: number) => encodeSamples(seed, c, k0, n),
+    };
+    this.stream = new PacedSampleStream(s, source, {
+      pumpMs: PACKET_MS / 2,
+      maxUnread: MAX_UNREAD,
+    });
+    this.stream.start();
   }
 
   private stopStream(): void {
-    if (this.timer) clearInterval(this.timer);
-    this.timer = undefined;
-  }
-
-  private pump(s: Socket, c: SimConfig): void {
-    if (s.destroyed) {
-      this.stopStream();
-      return;
-    }
-    const due = Math.floor(((performance.now() - this.t0) / 1000) * c.rate) - this.sent;
-    if (due < Math.max(1, (c.rate * PACKET_MS) / 1000)) return;
-    this.sent += due;
-    if (this.pendingTruncate) {
-      this.pendingTruncate = false;
-      const one = encodeSamples(this.seed, c, this.k, 1);
-      this.stopStream();
-      s.write(one.subarray(0, Math.floor(one.length / 2)), () => s.destroy());
-      return;
-    }
-    this.k += this.pendingSkip;
-    this.pendingSkip = 0;
-    const half = Math.floor(due / 2);
-    const parts = [encodeSamples(this.seed, c, this.k, half), ...this.pendingInject.splice(0)];
-    parts.push(encodeSamples(this.seed, c, this.k + half, due - half));
-    this.k += due;
-    if (s.writableLength < MAX_UNREAD) s.write(Buffer.concat(parts));
+    this.stream?.stop();
   }
 
   /** The connection drops (it connects again after `retry`). */
@@ -308,17 +285,17 @@ export class SessantaquattroSimulator {
 
   /** These bytes go out between two samples of the next packet. */
   inject(bytes: Uint8Array): void {
-    this.pendingInject.push(Buffer.from(bytes));
+    this.stream?.inject(bytes);
   }
 
   /** n samples are never sent (the counter jumps by n). */
   skip(n: number): void {
-    this.pendingSkip += n;
+    this.stream?.skip(n);
   }
 
   /** Half a sample goes out, then the connection drops. */
   truncate(): void {
-    this.pendingTruncate = true;
+    this.stream?.truncate();
   }
 
   async close(): Promise<void> {
