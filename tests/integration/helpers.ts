@@ -1,4 +1,5 @@
 /** Helpers for integration tests that run the real CLI bundle (dist/, built by `npm test`). */
+import { expect } from "vitest";
 import { spawn, spawnSync, type ChildProcess } from "node:child_process";
 import { existsSync, mkdtempSync } from "node:fs";
 import { tmpdir } from "node:os";
@@ -68,4 +69,18 @@ export async function until(ok: () => boolean, what: string, ms = 5000): Promise
     if (Date.now() - t0 > ms) throw new Error(`timed out waiting for ${what}`);
     await sleep(5);
   }
+}
+
+/**
+ * Stamps on a device's sample clock: one period apart, never wider (that would be a loss), never
+ * backwards. A burst that arrives ahead of real time (a loaded machine) is stamped closer, never
+ * ahead of its arrival, so only the median must be exactly one period.
+ */
+export function expectDeviceStamps(t: ArrayLike<number>, rate: number, n: number): void {
+  const steps: number[] = [];
+  for (let i = 1; i < n; i++) steps.push(t[i]! - t[i - 1]!);
+  for (const dt of steps) expect(dt).toBeGreaterThanOrEqual(0);
+  for (const dt of steps) expect(dt).toBeLessThanOrEqual(1 / rate + 1e-6);
+  steps.sort((a, b) => a - b);
+  expect(steps[steps.length >> 1]!).toBeCloseTo(1 / rate, 6);
 }
