@@ -14,7 +14,29 @@ import { Collector, scalarString } from "./pipeline/collector";
 import { isSettingsEntry, readSettings } from "./pipeline/keys";
 import { lineCounterOf, parseStage } from "./pipeline/parse";
 import { BLOCK_NAME_RE, type BlockModuleRef, type PipelineSettings } from "./pipeline/spec";
+import * as sdk from "./sdk";
 import { BLOCK_CATEGORIES } from "./sdk";
+
+/** Where a loaded module finds the SDK (the engine's own instance: its zod, its error classes). */
+const SDK_KEY = Symbol.for("mosaic.sdk");
+
+/** The import names that mean the SDK. */
+export const SDK_IMPORT = /^(mosaic\/sdk|@mosaic\/sdk)$/;
+
+/** Makes `mosaic/sdk` resolvable (through `sdkModuleSource`) for modules loaded in this thread. */
+export function installSdk(): void {
+  (globalThis as Record<symbol, unknown>)[SDK_KEY] = sdk;
+}
+
+/** The module text that stands for `mosaic/sdk` inside a user's module: this thread's SDK. */
+export function sdkModuleSource(): string {
+  const names = Object.keys(sdk).filter((n) => n !== "default");
+  return (
+    `const sdk = globalThis[Symbol.for("mosaic.sdk")];\n` +
+    `if (!sdk) throw new Error("mosaic/sdk is provided by MOSAIC when it loads a block module");\n` +
+    `export const { ${names.join(", ")} } = sdk;\n`
+  );
+}
 
 /** What a platform's module loader gives back for one module file. */
 export type ModuleLoadResult =

@@ -1,7 +1,8 @@
 /**
  * Loads a user's block module in Node (docs/writing-blocks.md): esbuild bundles the file with
  * what it imports (TypeScript transpiled, `.wasm` files as bytes, `mosaic/sdk` bound to this
- * engine's own SDK object), and the bundle is imported from a data: URL. A module that fails names
+ * engine's own SDK object), and the bundle is imported from a file in the temp folder (named by
+ * its content, source-mapped). A module that fails names
  * the reason, with the line and column of a syntax error. Results are kept per file until one of
  * the files the module was built from changes (the editor validates on every pause in typing).
  */
@@ -12,30 +13,19 @@ import { basename, dirname, isAbsolute, join, resolve } from "node:path";
 import { pathToFileURL } from "node:url";
 import type { Message, Plugin } from "esbuild";
 import { errorMessage } from "../engine/diagnostics";
-import * as sdk from "../engine/sdk";
-import { userFrame, type ModuleLoadResult } from "../engine/user-blocks";
+import {
+  installSdk as installEngineSdk,
+  sdkModuleSource,
+  SDK_IMPORT,
+  userFrame,
+  type ModuleLoadResult,
+} from "../engine/user-blocks";
 
-/** Where a loaded module finds the SDK (the engine's own instance: its zod, its error classes). */
-const SDK_KEY = Symbol.for("mosaic.sdk");
-
-/** The import names that mean the SDK. */
-const SDK_IMPORT = /^(mosaic\/sdk|@mosaic\/sdk)$/;
-
-/** Makes `mosaic/sdk` resolvable for modules loaded in this thread. */
+/** Makes `mosaic/sdk` resolvable for modules loaded in this thread (stacks source-mapped). */
 export function installSdk(): void {
-  (globalThis as Record<symbol, unknown>)[SDK_KEY] = sdk;
+  installEngineSdk();
   // Stack traces at the user's lines (the bundle carries its source map).
   process.setSourceMapsEnabled(true);
-}
-
-/** The module text that stands for `mosaic/sdk` inside a user's bundle. */
-function sdkShim(): string {
-  const names = Object.keys(sdk).filter((n) => n !== "default");
-  return (
-    `const sdk = globalThis[Symbol.for("mosaic.sdk")];\n` +
-    `if (!sdk) throw new Error("mosaic/sdk is provided by MOSAIC when it loads a block module");\n` +
-    `export const { ${names.join(", ")} } = sdk;\n`
-  );
 }
 
 const sdkPlugin: Plugin = {
@@ -43,7 +33,7 @@ const sdkPlugin: Plugin = {
   setup(b) {
     b.onResolve({ filter: SDK_IMPORT }, () => ({ path: "sdk", namespace: "mosaic-sdk" }));
     b.onLoad({ filter: /.*/, namespace: "mosaic-sdk" }, () => ({
-      contents: sdkShim(),
+      contents: sdkModuleSource(),
       loader: "js",
     }));
   },

@@ -16,6 +16,7 @@ import { CoarseLoop } from "../engine/runtime/coarse-loop";
 import { RealtimeLoop } from "../engine/runtime/loop";
 import { EngineSession, type LoopHooks, type SessionPlatform } from "../engine/session";
 import type { Runtime } from "../engine/runtime/runtime";
+import { loadBrowserBlockModule } from "./block-modules";
 
 declare const self: DedicatedWorkerGlobalScope;
 
@@ -139,6 +140,8 @@ async function boot(): Promise<void> {
   if (!r.ok) throw new Error(`cannot load the DSP core: HTTP ${r.status}`);
   initDsp(await r.arrayBuffer());
   session = new EngineSession(catalog, platform);
+  // Users' block modules served beside the pipeline (self-contained JavaScript).
+  blockModules: loadBrowserBlockModule,
   for (const m of pending.splice(0)) await session.handle(m);
 }
 

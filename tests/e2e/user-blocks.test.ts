@@ -17,7 +17,9 @@ import {
   launchChromium,
   openApp,
   ROOT,
+  serveApp,
   type Chromium,
+  type Served,
 } from "./harness";
 
 /** The guide's block and pipeline, written into `dir`. */
@@ -148,4 +150,46 @@ describe.skipIf(!haveChromium)("a user's block in mosaic serve's UI (Chromium)",
     expect(errors).toEqual([]);
     await close();
   }, 120_000);
+});
+
+describe.skipIf(!haveChromium)("a user's JavaScript block in the browser build (Chromium)", () => {
+  let served: Served;
+  let browser: Chromium;
+
+  beforeAll(async () => {
+    served = await serveApp();
+    browser = await launchChromium();
+  }, 120_000);
+
+  afterAll(async () => {
+    await browser?.close();
+    await served?.close();
+  });
+
+  test("a module served beside the pipeline runs in the page's engine and is in the palette", async () => {
+    const { page, errors, close } = await openApp(
+      browser,
+      served.url,
+      "e2e/user-blocks/pipeline.yaml",
+    );
+    await page.waitForSelector('[data-block="Smooth"][data-status="ontime"]', { timeout: 20_000 });
+    expect(await page.textContent("header")).toMatch(/in this page/);
+    await page.click('button:has-text("Edit")');
+    await page.locator('.palette__item[data-block-type="Smoother"]').waitFor({ timeout: 15_000 });
+    await page.screenshot({ path: artifact("user-blocks-browser.png") });
+    expect(errors).toEqual([]);
+    await close();
+  }, 60_000);
+
+  test("a TypeScript module is refused with the reason, at its Blocks: line", async () => {
+    const { page, close } = await openApp(browser, served.url, "e2e/user-blocks/typescript.yaml", {
+      waitRunning: false,
+    });
+    await page.waitForFunction(
+      `/typescript\\.yaml:3:\\d+.*cannot load user blocks from blocks\\/smoother\\.ts: the browser build cannot transpile TypeScript/s.test(document.body.textContent || "")`,
+      undefined,
+      { timeout: 20_000 },
+    );
+    await close();
+  }, 60_000);
 });
