@@ -21,13 +21,13 @@ import { useEngine, useEngineState, useLiveBlock } from "../client/hooks";
 import { ParamsForm, type SetResult } from "../forms/params-form";
 import { HEATMAP_DEFAULTS, Heatmap, type HeatmapSettings } from "./heatmap";
 import { LabelDisplay } from "./labels";
+import { PlayerView } from "./player-view";
 import { SCOPE_DEFAULTS, Scope, type ScopeSettings } from "./scope";
 import { SPIDER_DEFAULTS, SpiderPlot, type SpiderSettings } from "./spider";
-import { PlayerView } from "./player-view";
 import { StatusView, useStatusRecorder } from "./status";
+import { TrainingView } from "./training-view";
 import type { OutputInfo } from "./view-props";
 import "./panels.css";
-import { TrainingView } from "./training-view";
 
 export interface BlockPanelProps {
   block: BlockInfo;
@@ -48,14 +48,14 @@ const TAB_TITLE: Record<Tab, string> = {
   spider: "Spider",
   heatmap: "Heatmap",
   label: "Labels",
+  training: "Training",
+  player: "Player",
   params: "Params",
   status: "Status",
 };
 const DATA_VIEWS: readonly string[] = ["scope", "spider", "heatmap", "label", "training", "player"];
 
 interface Settings {
-  training: "Training",
-  player: "Player",
   scope: ScopeSettings;
   spider: SpiderSettings;
   heatmap: HeatmapSettings;
@@ -149,6 +149,10 @@ export function BlockPanel({
     body = <StatusView block={block} recorder={recorder} active={visible} />;
   } else if (tab === "label") {
     body = <LabelDisplay block={block} active={active} />;
+  } else if (tab === "training") {
+    body = <TrainingView block={block} active={active} />;
+  } else if (tab === "player") {
+    body = <PlayerView block={block} active={active} />;
   } else if (!output) {
     body = <p className="mp-muted">{block.name} has no output with values to show.</p>;
   } else if (tab === "scope") {
@@ -158,10 +162,6 @@ export function BlockPanel({
         tools={tools}
         block={block}
         output={output}
-  } else if (tab === "training") {
-    body = <TrainingView block={block} active={active} />;
-  } else if (tab === "player") {
-    body = <PlayerView block={block} active={active} />;
         active={active}
         settings={settings.scope}
         onSettings={patch("scope")}
