@@ -39,6 +39,14 @@ await build({
   // Native modules cannot be bundled; esbuild (loading users' block modules) runs its binary.
   external: ["serialport", "@serialport/*", "@abandonware/noble", "electron", "koffi", "esbuild"],
 });
+// The block SDK (package.json exports "./sdk") for users' own scripts and tests; MOSAIC itself
+// hands a loaded block module its own SDK object (app/host/user-blocks.ts).
+await build({
+  ...common,
+  entryPoints: present({ sdk: "app/engine/sdk.ts" }),
+  outdir: "dist",
+  banner: {},
+});
 await build({
   ...common,
   entryPoints: present({ "tools/gen-docs": "tools/gen-docs.ts" }),
