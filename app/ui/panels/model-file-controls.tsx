@@ -9,8 +9,11 @@ import { useRef, useState, type ChangeEvent, type ReactNode } from "react";
 import type { BlockInfo } from "../../engine/protocol";
 import { useEngine, useEngineState } from "../client/hooks";
 
-/** The biggest model file read (a model of 2048 inputs and 4096 outputs fits). */
-const MAX_MODEL_BYTES = 256 * 1024 * 1024;
+/**
+ * The biggest model file sent (within the 8 MiB a message to mosaic serve may hold: a ridge
+ * model of some 600 features, an RFF model of D ≈ 600).
+ */
+const MAX_MODEL_BYTES = 7 * 1024 * 1024;
 
 export function ModelFileControls({ block }: { block: BlockInfo }): ReactNode {
   const client = useEngine();
@@ -30,7 +33,10 @@ export function ModelFileControls({ block }: { block: BlockInfo }): ReactNode {
     e.target.value = "";
     if (!file) return;
     if (file.size > MAX_MODEL_BYTES) {
-      setReply({ ok: false, message: `${file.name} is too big for a model file` });
+      setReply({
+        ok: false,
+        message: `${file.name} has ${file.size} bytes; a model file sent from the page may have at most ${MAX_MODEL_BYTES}`,
+      });
       return;
     }
     await run("load", { name: file.name, text: await file.text() });
