@@ -6,55 +6,22 @@
  * another ABI version, or no Rust block at all, is refused with what to do; a panic in the kernel
  * is an error of its block, which goes on.
  */
-import { spawnSync } from "node:child_process";
-import { cpSync, readFileSync, rmSync, writeFileSync } from "node:fs";
+import { rmSync } from "node:fs";
 import { join } from "node:path";
 import { afterAll, beforeAll, describe, expect, it } from "vitest";
 import { z } from "zod";
 import { Frame, vectorShape } from "../../app/engine/frame";
 import { RUST_BLOCK_ABI_VERSION, rustBlock } from "../../app/engine/rust-block";
 import { BlockHarness } from "../../app/engine/testing";
-import { ROOT, tempDir } from "./helpers";
-
-const TEMPLATE = join(ROOT, "templates", "rust-block");
+import { abiVersionEdit, buildTemplate, tkeoFixture } from "../support/rust-template";
+import { tempDir } from "./helpers";
 
 interface WasmGlobal {
   Module: { new (bytes: Uint8Array): object; imports(module: object): unknown[] };
   Instance: new (module: object, imports: object) => { exports: unknown };
 }
 
-interface TkeoFixture {
-  frames: number;
-  channels: number;
-  input: number[];
-  expected: number[];
-  expected_rectified: number[];
-}
-
-const fixture = JSON.parse(
-  readFileSync(join(TEMPLATE, "tests", "fixtures", "tkeo.json"), "utf8"),
-) as TkeoFixture;
-
-/** Copies the template to `dir` (without build outputs), applies `edits`, builds it; returns the .wasm bytes. */
-function buildTemplate(dir: string, edits: { file: string; from: string; to: string }[] = []) {
-  cpSync(TEMPLATE, dir, {
-    recursive: true,
-    filter: (src) => !src.includes(`${TEMPLATE}/target`) && !src.endsWith("Cargo.lock"),
-  });
-  for (const e of edits) {
-    const path = join(dir, e.file);
-    const text = readFileSync(path, "utf8");
-    if (!text.includes(e.from)) throw new Error(`${e.file} has no '${e.from}'`);
-    writeFileSync(path, text.replace(e.from, e.to));
-  }
-  const r = spawnSync(
-    "cargo",
-    ["build", "--release", "--target", "wasm32-unknown-unknown", "--quiet"],
-    { cwd: dir, encoding: "utf8", timeout: 240_000 },
-  );
-  if (r.status !== 0) throw new Error(`cargo build failed in ${dir}:\n${r.stderr}`);
-  return readFileSync(join(dir, "target", "wasm32-unknown-unknown", "release", "tkeo.wasm"));
-}
+const fixture = tkeoFixture();
 
 function tkeoBlock(wasm: Uint8Array) {
   return rustBlock({
@@ -198,9 +165,7 @@ describe("the template's Tkeo block, built with cargo and loaded through rustBlo
 
 describe("modules rustBlock refuses, with what to do", () => {
   it("a module of another ABI version", () => {
-    const v2 = buildTemplate(join(work, "abi2"), [
-      { file: "src/abi.rs", from: "ABI_VERSION: u32 = 1", to: "ABI_VERSION: u32 = 2" },
-    ]);
+    const v2 = buildTemplate(join(work, "abi2"), [abiVersionEdit(2)]);
     expect(() => tkeoBlock(v2)).toThrow(
       "tkeo.wasm speaks Rust block ABI version 2, but this MOSAIC speaks version 1 " +
         "(docs/rust-block-abi.md): update MOSAIC, or rebuild the block from this MOSAIC's template",
