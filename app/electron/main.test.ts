@@ -5,7 +5,8 @@
  * files and real files: the app:// protocol answers with the security headers, IPC from the
  * window's main frame reaches the hub and the engine's answers come back, IPC from another frame
  * is ignored, File → Open loads and starts a pipeline and records it in Open Recent, Save As
- * writes it, navigation away and window.open are refused, and quitting closes the engine.
+ * writes it, navigation away and window.open are refused (except the participant window, opened
+ * on the second display and linked to the same engine), and quitting closes the engine.
  */
 import { execFileSync } from "node:child_process";
 import { existsSync, mkdtempSync, readFileSync, rmSync } from "node:fs";
@@ -39,7 +40,7 @@ class Emitter {
 }
 
 function fakeElectron(userData: string, dialogs: { open?: string; save?: string }) {
-  const sent: { channel: string; msg: Record<string, unknown> }[] = [];
+  const sent: { channel: string; msg: Record<string, unknown>; to: number }[] = [];
   let protocolHandler: ((req: Request) => Promise<Response>) | undefined;
   let ipcHandler: Handler | undefined;
   let menu: MenuItem[] = [];
@@ -69,7 +70,8 @@ function fakeElectron(userData: string, dialogs: { open?: string; save?: string 
     openHandler: Handler | undefined;
     isDestroyed = () => false;
     getURL = () => this.url;
-    send = (channel: string, msg: Record<string, unknown>) => void sent.push({ channel, msg });
+    send = (channel: string, msg: Record<string, unknown>) =>
+      void sent.push({ channel, msg, to: this.id });
     setWindowOpenHandler = (h: Handler) => void (this.openHandler = h);
     reload = () => {};
     toggleDevTools = () => {};
@@ -82,6 +84,10 @@ function fakeElectron(userData: string, dialogs: { open?: string; save?: string 
       app.emit("web-contents-created", {}, this.webContents);
     }
     static getFocusedWindow = () => windows[0];
+    static fromWebContents = (c: unknown) => windows.find((w) => w.webContents === c);
+    focused = 0;
+    focus = () => void this.focused++;
+    getBounds = () => ({ x: 0, y: 0, width: 1400, height: 900 });
     loadURL = async (url: string) => {
       this.webContents.url = url;
       this.webContents.mainFrame.url = url;
@@ -90,9 +96,27 @@ function fakeElectron(userData: string, dialogs: { open?: string; save?: string 
     isMinimized = () => false;
     show = () => {};
   }
+  // A laptop and, to its right, the participant's monitor.
+  const displays = [
+    {
+      id: 1,
+      bounds: { x: 0, y: 0, width: 1920, height: 1200 },
+      workArea: { x: 0, y: 0, width: 1920, height: 1160 },
+    },
+    {
+      id: 2,
+      bounds: { x: 1920, y: 0, width: 1920, height: 1080 },
+      workArea: { x: 1920, y: 0, width: 1920, height: 1080 },
+    },
+  ];
   const electron = {
     app,
     BrowserWindow: FakeWindow,
+    screen: {
+      getAllDisplays: () => displays,
+      getDisplayMatching: () => displays[0],
+      getPrimaryDisplay: () => displays[0],
+    },
     protocol: {
       registerSchemesAsPrivileged: () => {},
       handle: (_scheme: string, h: (req: Request) => Promise<Response>) => (protocolHandler = h),
@@ -230,6 +254,35 @@ describe("main process (bundled, with a stand-in electron module)", () => {
     await until(() => fake.sent.some((s) => s.msg.type === "reply" && s.msg.id === 5));
     expect(fake.sent.slice(n).some((s) => s.msg.id === 99)).toBe(false);
     expect(fake.sent.find((s) => s.msg.id === 5)!.msg).toMatchObject({ ok: false });
+  });
+
+  test("the page's participant window opens full screen on the second display, on the same engine", async () => {
+    const main = fake.windows[0]!;
+    const url = `${APP_ENTRY}?view=participant&block=Cues`;
+    expect(main.webContents.openHandler?.({ url })).toEqual({ action: "deny" });
+    expect(fake.windows).toHaveLength(2);
+    const p = fake.windows[1]!;
+    expect(p.webContents.getURL()).toBe(url);
+    expect(p.options).toMatchObject({
+      x: 1920,
+      y: 0,
+      width: 1920,
+      height: 1080,
+      fullscreen: true,
+      webPreferences: { sandbox: true, contextIsolation: true, nodeIntegration: false },
+    });
+    // Its page speaks to the same engine: hello comes back to it.
+    const contents = p.webContents;
+    fake.ipc()(
+      { sender: contents, senderFrame: contents.mainFrame },
+      { type: "hello", version: 1 },
+    );
+    await until(() => fake.sent.some((s) => s.to === contents.id && s.msg.type === "hello"));
+    // Asked again, it comes forward; nothing else opens.
+    main.webContents.openHandler?.({ url });
+    main.webContents.openHandler?.({ url: "app://mosaic/index.html?pipeline=demo.yaml" });
+    expect(fake.windows).toHaveLength(2);
+    expect(p.focused).toBe(1);
   });
 
   test("File → Open loads and starts the pipeline; Open Recent and Save As follow", async () => {

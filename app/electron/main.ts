@@ -2,9 +2,11 @@
  * The desktop app's main process (bundled to dist/electron/main.cjs). Thin on purpose: it starts
  * the host in this process (a SessionHub: the engine session runs in a worker thread, devices are
  * opened here), serves the UI on the privileged `app://mosaic/` scheme, opens one sandboxed
- * window and relays the UI↔engine protocol between it and the hub over one IPC channel. The
+ * window (and, when its page asks, the participant window, on a second display) and relays the
+ * UI↔engine protocol between each window and the hub over one IPC channel. The
  * logic lives in plain modules tested without Electron: security.ts, protocol-files.ts,
- * window-link.ts, menu.ts, recent.ts, pipeline-files.ts, paths.ts. See docs/desktop.md.
+ * window-link.ts, menu.ts, recent.ts, pipeline-files.ts, paths.ts, participant-window.ts. See
+ * docs/desktop.md.
  */
 import {
   app,
@@ -13,6 +15,7 @@ import {
   ipcMain,
   Menu,
   protocol,
+  screen,
   session,
   type IpcMainEvent,
   type WebContents,
@@ -29,6 +32,7 @@ import {
   readPipelineFile,
   writePipelineFile,
 } from "./pipeline-files";
+import { isParticipantUrl, participantPlacement } from "./participant-window";
 import { serveAppRequest } from "./protocol-files";
 import { RECENT_FILE, RecentFiles } from "./recent";
 import {
@@ -57,6 +61,8 @@ let recent: RecentFiles | undefined;
 /** The pipeline last loaded (from the menu or by the page): what "Save Pipeline As…" writes. */
 let lastLoaded: LoadedPipeline | undefined;
 const windows = new Map<number, { win: BrowserWindow; link: WindowLink }>();
+/** Participant windows by URL (one per Stimulus block): a second click brings it forward. */
+const participants = new Map<string, BrowserWindow>();
 /** Files named on the command line or by the OS before the hub was up. */
 const pendingFiles: string[] = [];
 /** Set when the app quits: the engine worker's exit is expected then. */
@@ -204,8 +210,12 @@ function onIpc(event: IpcMainEvent, raw: unknown): void {
   entry.link.receive(raw);
 }
 
-function createWindow(): void {
-  if (!hub) return;
+/** A window on the app's page `url` with the preload, linked to the hub like the first one. */
+function createWindow(
+  url = APP_ENTRY,
+  options: Electron.BrowserWindowConstructorOptions = {},
+): BrowserWindow | undefined {
+  if (!hub) return undefined;
   const win = new BrowserWindow({
     width: 1400,
     height: 900,
@@ -214,6 +224,7 @@ function createWindow(): void {
     show: false,
     title: "MOSAIC",
     backgroundColor: "#ffffff",
+    ...options,
     webPreferences: windowWebPreferences(layout.preload, dev),
   });
   const contents = win.webContents;
@@ -228,7 +239,34 @@ function createWindow(): void {
   contents.on("render-process-gone", (_e, details) => {
     problem(`the window's renderer ended (${details.reason}); View → Reload brings it back`);
   });
-  void win.loadURL(APP_ENTRY);
+  void win.loadURL(url);
+  return win;
+}
+
+/**
+ * The participant screen asked for by the page's "Participant window" button: its own window on
+ * the same engine, full screen on a second display when there is one (participant-window.ts).
+ */
+function openParticipantWindow(url: string, opener: WebContents): void {
+  const open = participants.get(url);
+  if (open && !open.isDestroyed()) {
+    open.focus();
+    return;
+  }
+  const from = BrowserWindow.fromWebContents(opener) ?? focusedWindow();
+  const here = from ? screen.getDisplayMatching(from.getBounds()) : screen.getPrimaryDisplay();
+  const place = participantPlacement(screen.getAllDisplays(), here);
+  const win = createWindow(url, {
+    ...place.bounds,
+    fullscreen: place.fullscreen,
+    minWidth: 400,
+    minHeight: 300,
+    title: "MOSAIC — participant",
+    autoHideMenuBar: true,
+  });
+  if (!win) return;
+  participants.set(url, win);
+  win.on("closed", () => participants.delete(url));
 }
 
 // Every web contents (the window, DevTools): no navigation away from the app, no new windows,
@@ -241,7 +279,11 @@ app.on("web-contents-created", (_event, contents) => {
     if (!isAllowedNavigation(url)) e.preventDefault();
   });
   contents.on("will-attach-webview", (e) => e.preventDefault());
-  contents.setWindowOpenHandler(() => ({ action: "deny" }));
+  // The participant window is opened here, on the same engine; nothing else opens.
+  contents.setWindowOpenHandler(({ url }) => {
+    if (isParticipantUrl(url)) openParticipantWindow(url, contents);
+    return { action: "deny" };
+  });
 });
 
 /** Pipeline files given as arguments (`MOSAIC file.yaml`, "Open with…" on Windows and Linux). */
