@@ -186,6 +186,7 @@ describe("FilePlayer", () => {
     h.clock = 0.5;
     // At half a second into the recording, twice as fast: row 1 (at 1 s) is due 0.25 s later.
     h.instance.setParam!("Speed", 2);
+    expect(h.desiredRate).toBe(2);
     h.fireOneShot();
     h.fireOneShot();
     expect(h.output().t).toEqual([0, 0.75, 1.25]);

@@ -585,6 +585,8 @@ function play(ctx: BlockContext, p: Params, timed: boolean, src: RowSource): Blo
       if (!Number.isNaN(base) && !Number.isNaN(anchor)) {
         base = anchor - ((anchor - base) * speed) / v;
       }
+      // The rate it is judged by follows (unless the file declares one).
+      if (ctx.declaredRate === undefined) ctx.setDesiredRate(v / median);
     }
     speed = v;
     schedule();
