@@ -39,17 +39,19 @@ const LENGTHS = [64, 74, 68, 54] as const;
 const Palm = () => <rect x={48} y={108} width={104} height={104} rx={30} />;
 const Forearm = () => <rect x={68} y={196} width={64} height={70} rx={10} />;
 
-/** Fingers folded into the palm: knuckles on top, the finger ends across the palm. */
-function Folded({ skip = -1 }: { skip?: number }) {
+/** The knuckles of fingers folded into the palm (drawn behind it: only their tops show). */
+function Knuckles({ skip = -1 }: { skip?: number }) {
   return (
     <g>
       {BASES.map((x, i) =>
-        i === skip ? null : <rect key={x} x={x - 12} y={96} width={24} height={36} rx={12} />,
+        i === skip ? null : <rect key={x} x={x - 12} y={92} width={24} height={40} rx={12} />,
       )}
-      <path d="M58 150 H142 M58 172 H142" className="gesture-svg__line" />
     </g>
   );
 }
+
+/** The folded fingers' ends across the palm. */
+const FoldLines = () => <path d="M58 150 H142 M58 172 H142" className="gesture-svg__line" />;
 
 function OpenHand({ spread, relaxed = false }: { spread: boolean; relaxed?: boolean }) {
   const angles = spread ? [-14, -4, 5, 15] : [-3, -1, 1, 3];
@@ -70,8 +72,9 @@ function Fist({ thumbUp = false }: { thumbUp?: boolean }) {
   return (
     <g>
       <Forearm />
+      <Knuckles />
       <Palm />
-      <Folded />
+      <FoldLines />
       {thumbUp ? (
         <Finger x={54} y={150} len={62} angle={-6} width={26} />
       ) : (
@@ -81,17 +84,27 @@ function Fist({ thumbUp = false }: { thumbUp?: boolean }) {
   );
 }
 
+/** A bent finger or thumb along a path: an outlined band (two strokes). */
+function Bent({ d }: { d: string }) {
+  return (
+    <g className="gesture-svg__bent">
+      <path d={d} className="gesture-svg__bent-outline" />
+      <path d={d} className="gesture-svg__bent-fill" />
+    </g>
+  );
+}
+
+/** Thumb and index tips touching in a ring, the other fingers straight. */
 function Pinch() {
   return (
-    <g>
+    <g transform="translate(22 0)">
       <Forearm />
       {BASES.slice(1).map((x, i) => (
         <Finger key={x} x={x} y={124} len={LENGTHS[i + 1]!} angle={[2, 6, 12][i]!} />
       ))}
-      <Finger x={62} y={124} len={52} angle={-38} />
-      <Finger x={54} y={168} len={70} angle={-14} width={26} />
+      <Bent d="M62 128 C62 44 -6 40 2 94" />
+      <Bent d="M60 190 C16 190 -8 140 4 108" />
       <Palm />
-      <circle cx={34} cy={86} r={9} className="gesture-svg__touch" />
     </g>
   );
 }
@@ -101,14 +114,50 @@ function Point() {
     <g>
       <Forearm />
       <Finger x={62} y={124} len={70} />
+      <Knuckles skip={0} />
       <Palm />
-      <Folded skip={0} />
+      <FoldLines />
       <rect x={46} y={128} width={84} height={26} rx={13} />
     </g>
   );
 }
 
-/** A curved arrow along an arc, its head at the end. */
+/** A point at `deg` degrees (clockwise from +x, as on screen) on a circle. */
+const onCircle = (cx: number, cy: number, r: number, deg: number): [number, number] => {
+  const a = (deg * Math.PI) / 180;
+  return [cx + r * Math.cos(a), cy + r * Math.sin(a)];
+};
+const xy = ([x, y]: [number, number]): string => `${x.toFixed(1)} ${y.toFixed(1)}`;
+
+/** A curved arrow along a circle from `from` to `to` degrees, its head at `to`. */
+function ArcArrow({
+  cx,
+  cy,
+  r,
+  from,
+  to,
+}: {
+  cx: number;
+  cy: number;
+  r: number;
+  from: number;
+  to: number;
+}) {
+  const clockwise = to > from;
+  const end = onCircle(cx, cy, r, to);
+  // Two short strokes back from the end, on either side of the circle.
+  const back = clockwise ? -14 : 14;
+  const d = `M${xy(onCircle(cx, cy, r, from))} A${r} ${r} 0 0 ${clockwise ? 1 : 0} ${xy(end)}`;
+  const head = `M${xy(onCircle(cx, cy, r - 12, to + back))} L${xy(end)} L${xy(onCircle(cx, cy, r + 12, to + back))}`;
+  return (
+    <g className="gesture-svg__arrow">
+      <path d={d} />
+      <path d={head} />
+    </g>
+  );
+}
+
+/** An arrow along any path, with its head drawn by `head`. */
 function Arrow({ d, head }: { d: string; head: string }) {
   return (
     <g className="gesture-svg__arrow">
@@ -120,21 +169,21 @@ function Arrow({ d, head }: { d: string; head: string }) {
 
 /** The wrist from the side: forearm level, the hand bent down (flexion) or up (extension). */
 function Wrist({ down }: { down: boolean }) {
-  const angle = down ? 48 : -48;
+  const angle = down ? 50 : -50;
   return (
     <g>
-      <rect x={6} y={140} width={104} height={44} rx={14} />
+      <rect x={-4} y={132} width={80} height={40} rx={14} />
       <g className="gesture-svg__ghost">
-        <rect x={100} y={142} width={92} height={40} rx={20} />
+        <rect x={66} y={132} width={92} height={40} rx={20} />
       </g>
-      <g transform={`rotate(${angle} 104 162)`}>
-        <rect x={100} y={142} width={92} height={40} rx={20} />
-        <rect x={112} y={132} width={34} height={16} rx={8} />
+      <g transform={`rotate(${angle} 70 152)`}>
+        <rect x={66} y={132} width={92} height={40} rx={20} />
+        <rect x={78} y={122} width={34} height={16} rx={8} />
       </g>
       {down ? (
-        <Arrow d="M176 126 A74 74 0 0 1 160 218" head="M148 206 L160 222 L170 204" />
+        <ArcArrow cx={70} cy={152} r={116} from={-6} to={58} />
       ) : (
-        <Arrow d="M176 198 A74 74 0 0 0 160 106" head="M148 118 L160 102 L170 120" />
+        <ArcArrow cx={70} cy={152} r={116} from={6} to={-58} />
       )}
     </g>
   );
@@ -167,6 +216,13 @@ const DRAWINGS: Record<GestureKind, () => ReactElement> = {
   supination: () => <Turn inward={false} />,
 };
 
+/** Type size (vmin) that fits a label's longest word in the box. */
+function textSize(label: string, size: "large" | "small"): number {
+  const longest = Math.max(1, ...label.split(/\s+/).map((w) => w.length));
+  const box = size === "large" ? 40 : 15;
+  return Math.min(size === "large" ? 9 : 3.5, (box / longest) * 1.6);
+}
+
 /** The drawing of `label`, or the label in large type when there is none. */
 export function GesturePicture({
   label,
@@ -182,7 +238,7 @@ export function GesturePicture({
         className={`gesture-picture gesture-picture--${size} gesture-picture--text`}
         data-kind="text"
       >
-        <span>{label}</span>
+        <span style={{ fontSize: `${textSize(label, size)}vmin` }}>{label}</span>
       </div>
     );
   }
