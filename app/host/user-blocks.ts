@@ -139,8 +139,18 @@ function stackPosition(e: unknown, file: string): { line?: number; col?: number 
 type Bundled =
   { ok: true; code: string; inputs: string[] } | Extract<ModuleLoadResult, { ok: false }>;
 
+/** esbuild, or why this MOSAIC cannot load block modules (a package without it). */
+async function esbuildOrWhy(): Promise<typeof import("esbuild") | string> {
+  try {
+    return await import("esbuild");
+  } catch (e) {
+    return `this MOSAIC has no esbuild to load block modules with (${errorMessage(e)}); run it from the repository after npm install`;
+  }
+}
+
 async function bundle(file: string): Promise<Bundled> {
-  const esbuild = await import("esbuild");
+  const esbuild = await esbuildOrWhy();
+  if (typeof esbuild === "string") return { ok: false, message: esbuild, inputs: [file] };
   const dir = dirname(file);
   try {
     const r = await esbuild.build({
