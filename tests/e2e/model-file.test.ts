@@ -126,6 +126,9 @@ describe.skipIf(!haveChromium)("a model file in the browser build (Chromium)", (
       .evaluateAll((els) => els.map((e) => Number(e.getAttribute("data-r2"))));
     expect(r2).toHaveLength(2);
     for (const v of r2) expect(v).toBeGreaterThan(0.5);
+    // The block's own (prequential) fit since training began, beside the window's figures.
+    const fit = panel.getByRole("table", { name: "R² per output (the block's fit)" });
+    expect(await fit.locator("tbody tr").count()).toBe(2);
     const matrix = panel.getByRole("table", { name: "Confusion matrix" });
     expect(await matrix.locator("tbody tr").count()).toBe(3);
     expect(

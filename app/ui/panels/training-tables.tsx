@@ -9,9 +9,20 @@ import type { TrainingSummary } from "./training-metrics";
 const fixed = (x: number, digits: number): string => (Number.isFinite(x) ? x.toFixed(digits) : "–");
 const percent = (x: number): string => (Number.isFinite(x) ? `${(x * 100).toFixed(1)} %` : "–");
 
-export function R2Table({ summary, names }: { summary: TrainingSummary; names: string[] }) {
+/** R² of every output; `label` names the table (the window, or the block's own fit). */
+export function R2Table({
+  r2,
+  names,
+  label = "R² per output",
+  className = "mp-r2",
+}: {
+  r2: ArrayLike<number>;
+  names: string[];
+  label?: string;
+  className?: string;
+}) {
   return (
-    <table className="mp-table mp-r2" aria-label="R² per output">
+    <table className={`mp-table ${className}`} aria-label={label}>
       <thead>
         <tr>
           <th scope="col">Output</th>
@@ -22,7 +33,7 @@ export function R2Table({ summary, names }: { summary: TrainingSummary; names: s
         {names.map((n, k) => (
           <tr key={n + k} data-output={n}>
             <th scope="row">{n}</th>
-            <td data-r2={summary.r2[k]}>{fixed(summary.r2[k]!, 3)}</td>
+            <td data-r2={r2[k]}>{fixed(r2[k]!, 3)}</td>
           </tr>
         ))}
       </tbody>
