@@ -104,8 +104,7 @@ export interface RustBlockOptions<S extends z.ZodType> extends Omit<
   /**
    * The params handed to the kernel's `new(params, channels)`, in this order; each must be a
    * number or a boolean (1 or 0) after validation. Default: every key of the `params` object
-   * schema, in the order written (a schema that is not a `z.object`, e.g. one with a
-   * `.transform`, needs this list).
+   * schema, in the order written.
    */
   kernelParams?: readonly string[];
   /** Names the module in messages (default: "<type>'s WebAssembly module"). */
@@ -206,7 +205,7 @@ function schemaKeys(params: z.ZodType, type: string): readonly string[] {
   const shape = (params as { shape?: unknown }).shape;
   if (shape !== null && typeof shape === "object") return Object.keys(shape);
   throw new Error(
-    `${type}: its params schema is not a z.object (a transform, a union…): ` +
+    `${type}: its params schema is not a plain z.object (refined or transformed): ` +
       "say which params the Rust kernel gets, in order, with kernelParams: [...]",
   );
 }

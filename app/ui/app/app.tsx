@@ -23,6 +23,7 @@ import { PresentationToggle } from "./presentation";
 import { RecordControl } from "./record";
 import { saveFile } from "./save-file";
 import { UiContext, type UiActions } from "./ui-context";
+import { usePanelLayouts } from "./use-panel-layouts";
 import { usePipeline, type PipelineEntry } from "./use-pipeline";
 import { useEventLog } from "./use-event-log";
 import { useWriteLiveValues } from "./use-live-values";
@@ -220,6 +221,9 @@ function Shell({
     );
     setStimulus((s) => (s !== null && graph?.blocks.some((b) => b.name === s) ? s : null));
   }, [graph]);
+  // Another pipeline (or the page) loaded: the panels saved for it come back (localStorage).
+  const nextZ = useCallback(() => ++zTop.current, []);
+  usePanelLayouts(graph, panels, setPanels, nextZ);
 
   // ---- actions
   const invoke = useCallback(

@@ -9,7 +9,9 @@ import type { BlockInfo } from "../../engine/protocol";
 import type { SetResult } from "../forms/params-form";
 import { BlockPanel } from "../panels/block-panel";
 import { useAvoidNode } from "./use-avoid-node";
+import type { PanelView } from "./panel-layouts";
 import { StatusDot } from "./status-dot";
+import { usePanelSize } from "./use-panel-size";
 import { useUi } from "./ui-context";
 
 /** Changes a param that is not live: the host edits the file and reloads it (not running). */
@@ -22,6 +24,11 @@ export interface OpenPanel {
   x: number;
   y: number;
   z: number;
+  /** Size of a floating panel the user resized, px. */
+  width?: number;
+  height?: number;
+  /** Its view (tab, output, view settings) as last reported, for saved panel layouts. */
+  view?: PanelView;
 }
 
 /** Whether the page is shown (not a background tab, not minimised). */
@@ -124,6 +131,7 @@ function PanelFrame({
   const onScreen = useOnScreen(ref);
   const visible = !panel.collapsed && onScreen && pageVisible;
   const drag = useRef<{ dx: number; dy: number } | null>(null);
+  usePanelSize(ref, panel.floating, panel, onUpdate);
   useAvoidNode(ref, block.name, panel.floating, onUpdate);
 
   const onPointerDown = (e: React.PointerEvent<HTMLElement>): void => {
@@ -169,7 +177,17 @@ function PanelFrame({
     <section
       ref={ref}
       className={`panel-frame${panel.floating ? " is-floating" : " is-docked"}${panel.collapsed ? " is-collapsed" : ""}`}
-      style={panel.floating ? { left: panel.x, top: panel.y, zIndex: panel.z } : undefined}
+      style={
+        panel.floating
+          ? {
+              left: panel.x,
+              top: panel.y,
+              zIndex: panel.z,
+              ...(panel.width !== undefined ? { width: panel.width } : {}),
+              ...(panel.height !== undefined && !panel.collapsed ? { height: panel.height } : {}),
+            }
+          : undefined
+      }
       aria-labelledby={titleId}
       data-panel={block.name}
       data-visible={String(visible)}
@@ -225,6 +243,8 @@ function PanelFrame({
           block={block}
           visible={visible}
           onClose={onClose}
+          {...(panel.view ? { view: panel.view } : {})}
+          onView={(view) => onUpdate({ view })}
           {...(block.type === "Stimulus"
             ? { onOpenStimulus: () => ui.openStimulus(block.name) }
             : {})}

@@ -18,6 +18,8 @@ import {
 import type { BlockInfo } from "../../engine/protocol";
 import { useUi } from "../app/ui-context";
 import { useEngine, useEngineState, useLiveBlock } from "../client/hooks";
+import { restoreSettings, type PanelView } from "../app/panel-layouts";
+import { useReportView } from "../app/use-panel-layouts";
 import { ParamsForm, type SetResult } from "../forms/params-form";
 import { HEATMAP_DEFAULTS, Heatmap, type HeatmapSettings } from "./heatmap";
 import { LabelDisplay } from "./labels";
@@ -38,6 +40,10 @@ export interface BlockPanelProps {
   onOpenStimulus?: () => void;
   /** Changes a non-live param while the pipeline is not running (the host reloads the file). */
   onEditStatic?: (param: string, value: unknown) => Promise<SetResult>;
+  /** A saved view to open with (saved panel layouts, app/ui/app/panel-layouts.ts). */
+  view?: PanelView;
+  /** Told the view (tab, output, view settings) whenever it changes. */
+  onView?: (view: PanelView) => void;
 }
 
 type DataView = "scope" | "spider" | "heatmap" | "label" | "training" | "player";
@@ -67,6 +73,8 @@ export function BlockPanel({
   onClose,
   onOpenStimulus,
   onEditStatic,
+  view,
+  onView,
 }: BlockPanelProps): ReactNode {
   const client = useEngine();
   const engineState = useEngineState();
@@ -79,18 +87,19 @@ export function BlockPanel({
     ],
     [block.views],
   );
-  const [chosen, setTab] = useState<Tab>(tabs[0]!);
+  const [chosen, setTab] = useState<Tab>(() => (view?.tab as Tab | undefined) ?? tabs[0]!);
   const tab = tabs.includes(chosen) ? chosen : tabs[0]!;
   // Outputs with values (timers' ticks carry none).
   const outputs = block.outputs as OutputInfo[];
   const valued = outputs.filter((o) => o.shape.rows * o.shape.cols > 0);
-  const [portName, setPort] = useState<string | undefined>(valued[0]?.name);
+  const [portName, setPort] = useState<string | undefined>(view?.port ?? valued[0]?.name);
   const output = valued.find((o) => o.name === portName) ?? valued[0];
-  const [settings, setSettings] = useState<Settings>({
-    scope: SCOPE_DEFAULTS,
-    spider: SPIDER_DEFAULTS,
-    heatmap: HEATMAP_DEFAULTS,
-  });
+  const [settings, setSettings] = useState<Settings>(() => ({
+    scope: restoreSettings(SCOPE_DEFAULTS, view?.settings?.scope),
+    spider: restoreSettings(SPIDER_DEFAULTS, view?.settings?.spider),
+    heatmap: restoreSettings(HEATMAP_DEFAULTS, view?.settings?.heatmap),
+  }));
+  useReportView(onView, tab, output?.name, settings);
   const patch = useCallback(
     <K extends keyof Settings>(k: K) =>
       (p: Partial<Settings[K]>) =>
