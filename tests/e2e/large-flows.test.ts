@@ -26,6 +26,7 @@ import {
   type Chromium,
   type Served,
 } from "./harness";
+import type { InPageElement, InPageWindow } from "./in-page";
 
 interface InPage {
   mosaic: { client: EngineClient };
@@ -35,7 +36,9 @@ interface InPage {
 async function viewport(page: Page): Promise<{ x: number; y: number; zoom: number }> {
   const t = await page.$eval(
     ".block-table .react-flow__viewport",
-    (el) => getComputedStyle(el).transform,
+    (el) =>
+      (globalThis as unknown as InPageWindow).getComputedStyle(el as unknown as InPageElement)
+        .transform,
   );
   const m = /matrix\(([^)]+)\)/.exec(t)!;
   const [a, , , , e, f] = m[1]!.split(",").map(Number);
@@ -45,8 +48,15 @@ async function viewport(page: Page): Promise<{ x: number; y: number; zoom: numbe
 async function waitViewportChange(page: Page, before: { x: number; y: number }): Promise<void> {
   await page.waitForFunction(
     (b) => {
-      const el = document.querySelector(".block-table .react-flow__viewport");
-      const m = /matrix\(([^)]+)\)/.exec(el ? getComputedStyle(el).transform : "");
+      const el = (globalThis as unknown as InPageWindow).document.querySelector(
+        ".block-table .react-flow__viewport",
+      );
+      const m = /matrix\(([^)]+)\)/.exec(
+        el
+          ? (globalThis as unknown as InPageWindow).getComputedStyle(el as unknown as InPageElement)
+              .transform
+          : "",
+      );
       if (!m) return false;
       const v = m[1]!.split(",").map(Number);
       return Math.hypot(v[4]! - b.x, v[5]! - b.y) > 20;
@@ -65,7 +75,9 @@ async function centre(page: Page, selector: string): Promise<{ x: number; y: num
 /** Position of a block node in canvas pixels (what its Layout would say). */
 async function nodePosition(page: Page, id: string): Promise<{ x: number; y: number }> {
   return page.$eval(`.block-table .react-flow__node[data-id="${id}"]`, (el) => {
-    const m = /translate\(([-\d.]+)px,\s*([-\d.]+)px\)/.exec((el as HTMLElement).style.transform)!;
+    const m = /translate\(([-\d.]+)px,\s*([-\d.]+)px\)/.exec(
+      (el as unknown as InPageElement).style.transform,
+    )!;
     return { x: Number(m[1]), y: Number(m[2]) };
   });
 }
@@ -125,7 +137,11 @@ describe.skipIf(!haveChromium)("large flows on the BlockTable (Chromium)", () =>
     );
     await page.hover(".block-table .react-flow__pane");
     await page.keyboard.press("Control+f");
-    await page.waitForFunction(() => document.activeElement?.matches(".block-search input"));
+    await page.waitForFunction(() =>
+      (globalThis as unknown as InPageWindow).document.activeElement?.matches(
+        ".block-search input",
+      ),
+    );
     await page.keyboard.type("ti");
     const expected = names.filter((n) => n.toLowerCase().includes("ti"));
     expect(expected.length).toBeGreaterThan(1); // Amplification, Rectification, …
@@ -133,7 +149,9 @@ describe.skipIf(!haveChromium)("large flows on the BlockTable (Chromium)", () =>
     const outline = (id: string) =>
       page.$eval(
         `.block-table .react-flow__node[data-id="${id}"]`,
-        (el) => getComputedStyle(el).outlineStyle,
+        (el) =>
+          (globalThis as unknown as InPageWindow).getComputedStyle(el as unknown as InPageElement)
+            .outlineStyle,
       );
     expect(await outline(expected[0]!)).toBe("solid");
     expect(await outline(names.find((n) => !expected.includes(n))!)).toBe("none");
@@ -144,8 +162,10 @@ describe.skipIf(!haveChromium)("large flows on the BlockTable (Chromium)", () =>
       // Centred: the node's middle comes to the graph's middle (the view animates there).
       await page.waitForFunction(
         (id) => {
-          const g = document.querySelector(".block-table")!.getBoundingClientRect();
-          const n = document
+          const g = (globalThis as unknown as InPageWindow).document
+            .querySelector(".block-table")!
+            .getBoundingClientRect();
+          const n = (globalThis as unknown as InPageWindow).document
             .querySelector(`.block-table .react-flow__node[data-id="${id}"]`)!
             .getBoundingClientRect();
           return (
@@ -182,35 +202,41 @@ describe.skipIf(!haveChromium)("large flows on the BlockTable (Chromium)", () =>
     const { zoom } = await viewport(page);
     const head = await centre(page, '.graph-box[data-box="group"] .graph-box__title');
     const gb = await group.evaluate((el) => ({
-      x: parseFloat((el as HTMLElement).style.left),
-      y: parseFloat((el as HTMLElement).style.top),
+      x: parseFloat((el as unknown as InPageElement).style.left),
+      y: parseFloat((el as unknown as InPageElement).style.top),
     }));
     const top = Math.min(timer.y, emg.y) - 40;
     await drag(page, head, (timer.x - 30 - gb.x) * zoom, (top - gb.y) * zoom);
     const corner = await centre(page, '.graph-box[data-box="group"] .graph-box__corner');
     const size = await group.evaluate((el) => ({
-      w: parseFloat((el as HTMLElement).style.width),
-      h: parseFloat((el as HTMLElement).style.height),
-      x: parseFloat((el as HTMLElement).style.left),
-      y: parseFloat((el as HTMLElement).style.top),
+      w: parseFloat((el as unknown as InPageElement).style.width),
+      h: parseFloat((el as unknown as InPageElement).style.height),
+      x: parseFloat((el as unknown as InPageElement).style.left),
+      y: parseFloat((el as unknown as InPageElement).style.top),
     }));
     const wantW = Math.max(emg.x + 260 - size.x, size.w);
     const wantH = Math.max(emg.y + 160 - size.y, timer.y + 160 - size.y, size.h);
     await drag(page, corner, (wantW - size.w) * zoom, (wantH - size.h) * zoom);
     const inside = await page.evaluate(() => {
-      const g = document.querySelector('.graph-box[data-box="group"]')!.getBoundingClientRect();
-      return [...document.querySelectorAll(".block-table .react-flow__node")]
+      const g = (globalThis as unknown as InPageWindow).document
+        .querySelector('.graph-box[data-box="group"]')!
+        .getBoundingClientRect();
+      return [
+        ...(globalThis as unknown as InPageWindow).document.querySelectorAll(
+          ".block-table .react-flow__node",
+        ),
+      ]
         .filter((n) => {
           const r = n.getBoundingClientRect();
           return r.left >= g.left && r.top >= g.top && r.right <= g.right && r.bottom <= g.bottom;
         })
-        .map((n) => (n as HTMLElement).dataset.id);
+        .map((n) => n.dataset.id);
     });
     expect(inside).toEqual(expect.arrayContaining(["Timer", "Emg"]));
 
     // Moving the group carries the blocks inside it, and only them.
     const ids = await page.$$eval(".block-table .react-flow__node", (els) =>
-      els.map((e) => (e as HTMLElement).dataset.id!),
+      els.map((e) => (e as unknown as InPageElement).dataset.id!),
     );
     const before = Object.fromEntries(
       await Promise.all(ids.map(async (id) => [id, await nodePosition(page, id)] as const)),
@@ -226,9 +252,11 @@ describe.skipIf(!haveChromium)("large flows on the BlockTable (Chromium)", () =>
     await page.waitForFunction(
       ({ ids, before }) =>
         ids.every((id) => {
-          const el = document.querySelector(`.block-table .react-flow__node[data-id="${id}"]`);
+          const el = (globalThis as unknown as InPageWindow).document.querySelector(
+            `.block-table .react-flow__node[data-id="${id}"]`,
+          );
           const m = /translate\(([-\d.]+)px,\s*([-\d.]+)px\)/.exec(
-            (el as HTMLElement).style.transform,
+            (el as unknown as InPageElement).style.transform,
           );
           return m !== null && Math.abs(Number(m[2]) - before[id]!.y - 80) < 0.5;
         }),
@@ -287,7 +315,7 @@ describe.skipIf(!haveChromium)("large flows on the BlockTable (Chromium)", () =>
     await again.page.setInputFiles(".file-open input[type=file]", saved);
     await again.page.waitForSelector('.graph-box[data-box="group"][data-label="Acquisition"]');
     const box = await again.page.$eval('.graph-box[data-box="group"]', (el) => {
-      const s = (el as HTMLElement).style;
+      const s = (el as unknown as InPageElement).style;
       return {
         X: parseFloat(s.left),
         Y: parseFloat(s.top),

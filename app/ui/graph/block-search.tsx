@@ -5,12 +5,7 @@
  */
 import { useReactFlow, type ReactFlowInstance } from "@xyflow/react";
 import { useEffect, useMemo, useRef, useState } from "react";
-
-/** Names that contain `query` (any case), in the order given; none for an empty query. */
-export function matchingNames(names: readonly string[], query: string): string[] {
-  const q = query.trim().toLowerCase();
-  return q === "" ? [] : names.filter((n) => n.toLowerCase().includes(q));
-}
+import { matchingNames } from "./find";
 
 /** Outlines of the matches (block names are plain words: safe inside a CSS string). */
 function highlightCss(matches: readonly string[], current: string | undefined): string {

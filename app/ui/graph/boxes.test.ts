@@ -2,7 +2,7 @@ import { readFileSync } from "node:fs";
 import { parseDocument } from "yaml";
 import { describe, expect, test } from "vitest";
 import type { GraphInfo } from "../../engine/protocol";
-import { matchingNames } from "./block-search";
+import { matchingNames } from "./find";
 import {
   NO_BOXES,
   initialBoxes,
