@@ -78,7 +78,7 @@ describe("block keys stage", () => {
     readSettings(c, parseDocument(src).get("Pipeline", true) as YAMLMap, settings);
     expect(settings.batchingMs).toBe(3);
     expect(c.list.map(formatDiagnostic)).toEqual([
-      "p.yaml:1:28: error: Pipeline: unknown setting 'Batch' (expected one of BatchingMs, Layout (a block named Pipeline needs a Type)); did you mean 'BatchingMs'?",
+      "p.yaml:1:28: error: Pipeline: unknown setting 'Batch' (expected one of BatchingMs, Layout, Blocks (a block named Pipeline needs a Type)); did you mean 'BatchingMs'?",
     ]);
   });
 });

@@ -364,7 +364,7 @@ export function isSettingsEntry(name: string | undefined, value: unknown): boole
   );
 }
 
-/** The settings entry `Pipeline: { BatchingMs, Layout }`. */
+/** The settings entry `Pipeline: { BatchingMs, Layout, Blocks }`. */
 export function readSettings(c: Collector, node: YAMLMap, settings: PipelineSettings): void {
   for (const it of node.items) {
     const k = scalarString(it.key) ?? "";
