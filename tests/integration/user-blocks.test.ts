@@ -7,11 +7,14 @@
  * that never returns on its own worker — each give a message naming the file or block, and the
  * rest of the pipeline keeps running.
  */
-import { execFileSync } from "node:child_process";
-import { mkdirSync, readFileSync, writeFileSync } from "node:fs";
+import { execFileSync, type ChildProcess } from "node:child_process";
+import { existsSync, mkdirSync, readFileSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
-import { beforeAll, describe, expect, test } from "vitest";
-import { jsonLines, requireBuild, ROOT, runCli, tempDir } from "./helpers";
+import { afterAll, beforeAll, describe, expect, test } from "vitest";
+import WebSocket from "ws";
+import type { EngineMessage } from "../../app/engine/protocol";
+import { decodeWire, encodeWire } from "../../app/engine/protocol-wire";
+import { jsonLines, requireBuild, ROOT, runCli, startCli, tempDir, until } from "./helpers";
 
 beforeAll(requireBuild);
 
@@ -276,4 +279,85 @@ describe("broken user blocks", () => {
     expect(byName.get("Smooth")!.events).toBeGreaterThan(400);
     expect(readLog(join(dir, "broken-smooth.csv")).length).toBeGreaterThan(400);
   }, 90_000);
+});
+
+describe("user blocks under mosaic serve: a page's pipeline runs code only from its folders", () => {
+  let dir: string;
+  let outside: string;
+  let cli: ChildProcess;
+  let ws: WebSocket;
+  const got: EngineMessage[] = [];
+
+  beforeAll(async () => {
+    dir = projectFromGuide();
+    outside = tempDir("mosaic-user-blocks-outside-");
+    // Top-level code that would leave a mark if it ever ran.
+    writeFileSync(
+      join(outside, "evil.mjs"),
+      `import { writeFileSync } from "node:fs";\nwriteFileSync(${JSON.stringify(join(outside, "ran"))}, "x");\nexport default {};\n`,
+    );
+    cli = startCli(["serve", join(dir, "pipeline.yaml"), "--port", "0", "--no-start"]);
+    let out = "";
+    const url = await new Promise<URL>((resolve, reject) => {
+      const t = setTimeout(() => reject(new Error(`no URL printed: ${out}`)), 30_000);
+      cli.stderr!.on("data", (d: Buffer) => (out += d.toString()));
+      cli.stdout!.on("data", (d: Buffer) => {
+        out += d.toString();
+        const m = /MOSAIC is at (\S+)/.exec(out);
+        if (m) {
+          clearTimeout(t);
+          resolve(new URL(m[1]!));
+        }
+      });
+    });
+    const target = new URL("/ws", url);
+    target.protocol = "ws:";
+    target.searchParams.set("token", url.searchParams.get("token")!);
+    ws = new WebSocket(target.href, { origin: url.origin });
+    ws.on("message", (d) => got.push(decodeWire(String(d)) as EngineMessage));
+    await new Promise((r) => ws.once("open", r));
+    ws.send(encodeWire({ type: "hello", version: 1 }));
+  }, 60_000);
+
+  afterAll(async () => {
+    ws?.close();
+    if (cli && cli.exitCode === null) {
+      cli.kill("SIGINT");
+      await new Promise((r) => cli.once("exit", r));
+    }
+  });
+
+  const reply = async (id: number) => {
+    await until(() => got.some((m) => m.type === "reply" && m.id === id), `reply ${id}`, 30_000);
+    return got.find((m) => m.type === "reply" && m.id === id) as Extract<
+      EngineMessage,
+      { type: "reply" }
+    >;
+  };
+
+  test("a module outside the allowed folders is refused before any of its code runs", async () => {
+    const source =
+      `Pipeline: { Blocks: [${join(outside, "evil.mjs")}] }\n` +
+      "Clock: { Type: ScheduledTimer, DesiredRate: 100 }\n";
+    ws.send(encodeWire({ type: "load", id: 1, file: join(dir, "evil.yaml"), source }));
+    const r = await reply(1);
+    expect(r.ok).toBe(false);
+    expect(r.diagnostics?.[0]?.message).toMatch(
+      /^cannot load user blocks from .*evil\.mjs: .*evil\.mjs is outside the folders this pipeline may run code from/,
+    );
+    expect(existsSync(join(outside, "ran"))).toBe(false);
+  }, 60_000);
+
+  test("the pipeline's own folder is allowed: its blocks load and the catalog lists them", async () => {
+    const source = readFileSync(join(dir, "pipeline.yaml"), "utf8");
+    ws.send(encodeWire({ type: "load", id: 2, file: join(dir, "pipeline.yaml"), source }));
+    const r = await reply(2);
+    expect(r.ok).toBe(true);
+    expect(r.graph?.blocks.find((b) => b.name === "Smooth")?.type).toBe("Smoother");
+    ws.send(encodeWire({ type: "catalog", id: 3 }));
+    const c = await reply(3);
+    const smoother = c.catalog?.types.find((t) => t.type === "Smoother");
+    expect(smoother?.help).toContain("(User block from blocks/smoother.ts.)");
+    expect(c.catalog?.types.some((t) => t.type === "Filter")).toBe(true);
+  }, 60_000);
 });
