@@ -326,6 +326,7 @@ export class EngineSession {
       }
       case "validate": {
         // What `mosaic validate` says of the text (app/engine/validate.ts); the running pipeline stays.
+        const own = await this.ownBlocks(msg.source, msg.file);
         const parse = this.platform.loadPipeline?.bind(this.platform);
         const diagnostics = own.failed
           ? own.diagnostics
@@ -333,7 +334,6 @@ export class EngineSession {
               resources: this.platform.resources(msg.file),
               ...(parse ? { parse: (text, f) => parse(text, f, own.catalog) } : {}),
             });
-        const own = await this.ownBlocks(msg.source, msg.file);
         this.reply(msg.id, true, undefined, { diagnostics });
         return;
       }
@@ -429,6 +429,8 @@ export class EngineSession {
     source: string,
     simulateDevices = false,
   ): Promise<{ diagnostics: Diagnostic[]; graph?: GraphInfo }> {
+    const own = await this.ownBlocks(source, file);
+    if (own.failed) return this.rejected(own.diagnostics);
     const parsed = this.platform.loadPipeline
       ? await this.platform.loadPipeline(source, file, own.catalog)
       : loadPipeline(source, file, own.catalog);
@@ -440,8 +442,6 @@ export class EngineSession {
     this.unload();
     this.file = file;
     this.simulated = simulateDevices;
-    const own = await this.ownBlocks(source, file);
-    if (own.failed) return this.rejected(own.diagnostics);
     const logs = this.platform.logs?.(file);
     const created = await Runtime.create({
       spec: loaded.spec,
@@ -460,6 +460,7 @@ export class EngineSession {
     }
     this.rt = created.runtime;
     this.spec = loaded.spec;
+    this.useBlocks(own, source);
     this.source = source;
     this.fileParams = this.liveParamsNow();
     this.setState("loaded");
@@ -473,7 +474,6 @@ export class EngineSession {
   }
 
   /**
-    this.useBlocks(own, source);
    * While a pipeline is loaded, the blocks of its replacement are first instantiated on a
    * virtual clock (as `validate` does) so that one that cannot be created does not stop it.
    */
