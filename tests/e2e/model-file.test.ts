@@ -4,7 +4,8 @@
  * predictor's Training view (a download), loaded from that file into a NEW page that runs only
  * the features, predicts exactly the same numbers for the same rows. The Training view shows R²
  * per output and, the targets being gestures, the confusion matrix. Waits are on what the page
- * shows or receives, never on fixed sleeps.
+ * shows or receives, never on fixed sleeps. On the training example the Stimulus's gestures
+ * name the figures.
  */
 import { readFileSync } from "node:fs";
 import type { Page } from "playwright-core";
@@ -178,6 +179,32 @@ describe.skipIf(!haveChromium)("a model file in the browser build (Chromium)", (
     expect(second.errors).toEqual([]);
     await second.close();
   }, 120_000);
+
+  test("the training example: the Stimulus's gestures name the Training view's figures", async () => {
+    const app = await openApp(chromium, served.url, "pipelines/examples/training.yaml");
+    const { page } = app;
+    await openTraining(page);
+    const panel = page.locator('[data-block-panel="Predictor"]');
+    // The first capture (3 s at 25 Hz) gives labelled samples.
+    await panel
+      .locator("[data-samples]")
+      .filter({ hasText: /^[1-9]\d+ labelled/ })
+      .waitFor({
+        timeout: 30_000,
+      });
+    const gestures = ["fist", "open", "pinch", "flexion", "extension"];
+    const r2Rows = await panel
+      .locator(".mp-r2 tbody th")
+      .evaluateAll((els) => els.map((e) => e.textContent));
+    expect(r2Rows).toEqual(gestures);
+    const heads = await panel
+      .getByRole("table", { name: "Confusion matrix" })
+      .locator("thead th")
+      .evaluateAll((els) => els.map((e) => e.textContent));
+    expect(heads).toEqual(["cued ↓ / predicted →", "rest", ...gestures, "accuracy"]);
+    expect(app.errors).toEqual([]);
+    await app.close();
+  }, 60_000);
 
   test("a file that is no model is refused with the reason; the model stays", async () => {
     const app = await openApp(chromium, served.url, "e2e/model-predict.yaml");
