@@ -273,6 +273,41 @@ Legacy: { Type: ScheduledTimer, DesiredRate: 100, Params: [] }
     expect(errors).toEqual([]);
   });
 
+  test("accepts the BlockTable's groups and comments in Pipeline: { Layout }", () => {
+    const errors = check(`
+Timer: { Type: ScheduledTimer, DesiredRate: 200 }
+Pipeline:
+  BatchingMs: 2
+  Layout:
+    Groups:
+      - { Title: Acquisition, X: -24, Y: -48, Width: 440, Height: 260 }
+    Comments:
+      - { Text: "Band-pass, then rectify", X: 480.5, Y: 300, Width: 220, Height: 90 }
+`);
+    expect(errors).toEqual([]);
+  });
+
+  test.each([
+    [
+      "a group without a Width",
+      "Pipeline: { Layout: { Groups: [{ Title: A, X: 0, Y: 0, Height: 9 }] } }",
+      /missing Width/,
+    ],
+    [
+      "a comment of zero height",
+      "Pipeline: { Layout: { Comments: [{ Text: a, X: 0, Y: 0, Width: 9, Height: 0 }] } }",
+      /Height: <= 0/,
+    ],
+    ["an unknown Layout key", "Pipeline: { Layout: { Notes: [] } }", /unknown key 'Notes'/],
+    [
+      "a block named Pipeline with an unknown Type",
+      "Pipeline: { Type: ScheduledTimr, DesiredRate: 200 }",
+      /matches none of anyOf/,
+    ],
+  ])("rejects %s (the Pipeline entry)", (_name, yamlText, expected) => {
+    expect(check(yamlText).join("\n")).toMatch(expected);
+  });
+
   test.each([
     ["an unknown Type", "A: { Type: ScheduledTimr, DesiredRate: 200 }", /not one of/],
     ["no Type", "A: { DesiredRate: 200 }", /missing Type/],

@@ -238,7 +238,11 @@ function pipelineSchema(blocks: readonly AnyBlockDefinition[]): JsonSchema {
         ],
       },
     },
-    patternProperties: { [BLOCK_NAME_PATTERN]: { $ref: "#/definitions/Block" } },
+    // Every name but the settings entry's (which `properties` covers, a block named so included):
+    // a key matching both would be checked against both.
+    patternProperties: {
+      [`^(?!${SETTINGS_KEY}$)${BLOCK_NAME_PATTERN.slice(1)}`]: { $ref: "#/definitions/Block" },
+    },
     additionalProperties: false,
     definitions: { Block: block, ...definitions },
   };
