@@ -441,6 +441,7 @@ function Shell({
               Stimulus
             </button>
           ) : null}
+          {stimuli.length > 0 ? <ParticipantButton block={stimuli[0]!.name} /> : null}
           <button
             type="button"
             aria-pressed={editing}
@@ -452,7 +453,6 @@ function Shell({
           </button>
           <label
             className="toggle simulate-devices"
-          {stimuli.length > 0 ? <ParticipantButton block={stimuli[0]!.name} /> : null}
             title={
               "Replace device blocks (Myo, Muovi, Delsys, NilsPod, …) by simulators of the same " +
               "shape and rate, and output devices (BlenderArm, Hannes, UDP, ROS) by blocks that " +
@@ -474,6 +474,7 @@ function Shell({
             />
             Simulate devices
           </label>
+          <PresentationToggle />
           <span className="toolbar__spacer" />
           <EngineBadge where={engine} />
           <span
@@ -484,7 +485,6 @@ function Shell({
             {!info.connected
               ? loss
                 ? "not connected"
-          <PresentationToggle />
                 : "engine starting…"
               : info.sharedMemory
                 ? "precise timing (shared memory)"

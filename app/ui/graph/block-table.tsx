@@ -31,12 +31,12 @@ import { LargeFlowTools } from "./large-flow-tools";
 import { layeredLayout } from "./layout";
 import { updateLayout } from "./layout-yaml";
 import { EdgeMarkerDefs, RateEdge, type RateEdgeType } from "./rate-edge";
+import { ReadableZoom } from "./readable-zoom";
 import { StatusIcon, STATUS_LABEL, type Status } from "./status";
 
 const nodeTypes = { block: BlockNode };
 /** Fit the pipeline, but never so small that it cannot be read (pan for the rest). */
 const FIT = { padding: 0.08, minZoom: 0.5, maxZoom: 1.25 };
-import { ReadableZoom } from "./readable-zoom";
 const edgeTypes = { rate: RateEdge };
 
 export interface BlockTableProps {
@@ -341,6 +341,7 @@ function Table(props: BlockTableProps) {
           maxZoom={2.5}
           aria-label="BlockTable: the pipeline's blocks and connections"
         >
+          <ReadableZoom target={box} />
           <Background gap={24} size={1.2} />
           <LargeFlowTools
             names={names}
@@ -372,7 +373,6 @@ function Table(props: BlockTableProps) {
           </Controls>
           <Panel position="top-right" className="graph-actions">
             <button type="button" onClick={autoLayout} title="Arrange the blocks automatically">
-          <ReadableZoom target={box} />
               Auto layout
             </button>
             <button
