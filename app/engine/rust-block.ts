@@ -104,7 +104,8 @@ export interface RustBlockOptions<S extends z.ZodType> extends Omit<
   /**
    * The params handed to the kernel's `new(params, channels)`, in this order; each must be a
    * number or a boolean (1 or 0) after validation. Default: every key of the `params` object
-   * schema, in the order written.
+   * schema, in the order written (a schema that is not a `z.object`, e.g. one with a
+   * `.transform`, needs this list).
    */
   kernelParams?: readonly string[];
   /** Names the module in messages (default: "<type>'s WebAssembly module"). */
@@ -205,7 +206,7 @@ function schemaKeys(params: z.ZodType, type: string): readonly string[] {
   const shape = (params as { shape?: unknown }).shape;
   if (shape !== null && typeof shape === "object") return Object.keys(shape);
   throw new Error(
-    `${type}: its params schema is not a plain z.object (refined or transformed): ` +
+    `${type}: its params schema is not a z.object (a transform, a union…): ` +
       "say which params the Rust kernel gets, in order, with kernelParams: [...]",
   );
 }

@@ -163,6 +163,81 @@ describe("the template's Tkeo block, built with cargo and loaded through rustBlo
   });
 });
 
+describe("params on their way to the kernel", () => {
+  const base = {
+    type: "Tkeo",
+    category: "Features" as const,
+    summary: "Teager–Kaiser energy.",
+    help: "ψ[n] = x[n]² − x[n−1]·x[n+1].",
+    wasmName: "tkeo.wasm",
+  };
+  const inputs = { inputs: [{ shape: vectorShape(2) }] };
+
+  it("go in kernelParams order; the kernel's Err is the block's error, in its words", async () => {
+    const params = z.strictObject({
+      Rectify: z.boolean().default(true).describe("Output |ψ|"),
+      Gain: z.number().default(3).describe("A param this kernel does not take"),
+    });
+    const none = rustBlock({ ...base, params, kernelParams: [], wasm: tkeoWasm });
+    const h = await BlockHarness.create(none, {}, inputs);
+    h.push(
+      Frame.from(
+        vectorShape(2),
+        [0, 1, 2],
+        [
+          [1, 4],
+          [4, 1],
+          [1, 4],
+        ],
+      ),
+    );
+    // No params reach the kernel: it does not rectify although Rectify defaults to true.
+    expect(h.out.get("out")!.v[2]).toEqual([15, -15]);
+
+    const both = rustBlock({ ...base, params, wasm: tkeoWasm });
+    await expect(BlockHarness.create(both, {}, inputs)).rejects.toThrow(
+      "expected 1 param (Rectify), got 2",
+    );
+  });
+
+  it("must be numbers or booleans, and a transformed schema needs kernelParams", async () => {
+    const text = rustBlock({
+      ...base,
+      params: z.strictObject({ Mode: z.string().default("fast").describe("Not a number") }),
+      wasm: tkeoWasm,
+    });
+    await expect(BlockHarness.create(text, {}, inputs)).rejects.toThrow(
+      "Tkeo: param Mode must be a number or a boolean for the Rust kernel, got string",
+    );
+    const transformed = z
+      .strictObject({ Rectify: z.boolean().default(false).describe("Output |ψ|") })
+      .transform((p) => ({ ...p }));
+    expect(() => rustBlock({ ...base, params: transformed, wasm: tkeoWasm })).toThrow(
+      "Tkeo: its params schema is not a z.object (a transform, a union…): say which " +
+        "params the Rust kernel gets, in order, with kernelParams: [...]",
+    );
+    const named = rustBlock({
+      ...base,
+      params: transformed,
+      kernelParams: ["Rectify"],
+      wasm: tkeoWasm,
+    });
+    const h = await BlockHarness.create(named, { Rectify: true }, inputs);
+    h.push(
+      Frame.from(
+        vectorShape(2),
+        [0, 1, 2],
+        [
+          [1, 4],
+          [4, 1],
+          [1, 4],
+        ],
+      ),
+    );
+    expect(h.out.get("out")!.v[2]).toEqual([15, 15]);
+  });
+});
+
 describe("modules rustBlock refuses, with what to do", () => {
   it("a module of another ABI version", () => {
     const v2 = buildTemplate(join(work, "abi2"), [abiVersionEdit(2)]);
