@@ -5,29 +5,32 @@
  * the plot area, which costs a fraction of stroking every segment. Samples go into per-channel
  * rings (ScopeBuffer) as data messages arrive (20 per second); the plot is redrawn at most once
  * per animation frame, with its right edge following an estimate of the engine's clock so that
- * it scrolls smoothly between messages.
- * Autoscale (widens at once, narrows over ~2 s) or a fixed Y range; pause (stops watching and
- * freezes the picture); time window; channel selection (at most 16 plotted by default).
+ * it scrolls smoothly between messages (scope-plot.ts, scope-draw.ts).
+ *
+ * Channels overlaid (one amplitude axis in the output's unit) or stacked (a lane each, with its
+ * name, range and unit). Autoscale (widens at once, narrows over ~2 s) or a fixed Y range. Pause
+ * holds the picture; the wheel zooms time (Shift: amplitude), a drag pans (and pauses), a double
+ * click resets; the readout gives the time and each channel's value under the cursor
+ * (scope-pointer.ts). The spectrum (Welch PSD, median frequency) is of the window in view
+ * (scope-spectrum.tsx); CSV and PNG export it (scope-export.ts).
  */
 import { useCallback, useEffect, useMemo, useRef, useState, type ReactNode } from "react";
-import uPlot from "uplot";
-import "uplot/dist/uPlot.min.css";
+import type uPlot from "uplot";
 import type { DataMessage } from "../../engine/protocol";
 import { useBlockData } from "../client/hooks";
-import {
-  StickyRange,
-  channelColor,
-  channelLabel,
-  defaultChannels,
-  finiteExtent,
-  formatTick,
-} from "./channels";
-import { ChannelPicker } from "./channel-picker";
-import { PlayPauseIcon, RangeInputs } from "./controls";
-import { countDraw, onFrame, viewStats } from "./frame";
+import { StickyRange, channelColor, channelLabel, defaultChannels } from "./channels";
+import { viewStats } from "./frame";
 import { ScopeBuffer, type MatrixMode } from "./scope-buffer";
-import { rasterTraces, rgbaWord, traceScratch, type TraceScratch } from "./trace-raster";
-import type { ViewProps } from "./view-props";
+import type { ScopeLive } from "./scope-draw";
+import { downloadCsv, downloadPng } from "./scope-export";
+import { defaultPlotHeight, useDrawLoop, usePlot } from "./scope-plot";
+import { attachPointer, isZoomed, readoutLines, showReadout } from "./scope-pointer";
+import { ScopeSpectrum } from "./scope-spectrum";
+import { ScopeToolbar } from "./scope-toolbar";
+import { rgbaWord } from "./trace-raster";
+import type { OutputInfo, ViewProps } from "./view-props";
+
+export { WINDOWS_S } from "./scope-toolbar";
 
 export interface ScopeSettings {
   /** Plotted channels (column indices); undefined: the first 16. */
@@ -38,6 +41,8 @@ export interface ScopeSettings {
   yMax: number;
   matrixMode: MatrixMode;
   paused: boolean;
+  layout: "overlaid" | "stacked";
+  spectrum: boolean;
 }
 
 export const SCOPE_DEFAULTS: ScopeSettings = {
@@ -47,17 +52,19 @@ export const SCOPE_DEFAULTS: ScopeSettings = {
   yMax: 1,
   matrixMode: "newest",
   paused: false,
+  layout: "overlaid",
+  spectrum: false,
 };
-
-export const WINDOWS_S = [2, 5, 10, 30] as const;
 
 /**
  * Events per second asked of the engine: about 1200 points across the window (2–3 per pixel
- * column of a docked panel), at most 1000/s. The engine keeps every n-th event (its watch
+ * column of a docked panel), at most 1000/s; with the spectrum on, the source's rate up to
+ * 1000/s (a decimated stream would alias). The engine keeps every n-th event (its watch
  * decimates), which is what the footer reports.
  */
-export function scopeMaxRate(windowS: number): number {
-  return Math.max(25, Math.min(1000, Math.round(1200 / windowS)));
+export function scopeMaxRate(windowS: number, spectrumOfRate = 0): number {
+  const base = Math.max(25, Math.min(1000, Math.round(1200 / windowS)));
+  return Math.max(base, Math.min(1000, Math.round(spectrumOfRate)));
 }
 
 const colourWords = new Map<string, number>();
@@ -79,80 +86,48 @@ function colourWord(css: string): number {
   return w;
 }
 
-/** The offscreen image the traces are drawn into, sized to the plot area (device pixels). */
-interface TraceLayer {
-  canvas: HTMLCanvasElement;
-  ctx: CanvasRenderingContext2D;
-  image: ImageData;
-  words: Uint32Array;
-  scratch: TraceScratch;
-}
-
-function traceLayer(width: number, height: number): TraceLayer | null {
-  const canvas = document.createElement("canvas");
-  canvas.width = Math.max(1, width);
-  canvas.height = Math.max(1, height);
-  const ctx = canvas.getContext("2d");
-  if (!ctx) return null;
-  const image = ctx.createImageData(canvas.width, canvas.height);
+function newLive(settings: ScopeSettings): ScopeLive {
   return {
-    canvas,
-    ctx,
-    image,
-    words: new Uint32Array(image.data.buffer),
-    scratch: traceScratch(canvas.width),
+    buffer: null,
+    plot: null,
+    dirty: false,
+    offset: NaN,
+    x: [0, 1],
+    y: [-1, 1],
+    sticky: new StickyRange(2),
+    laneSticky: [],
+    laneY: [],
+    lastDraw: 0,
+    span: settings.windowS,
+    right: NaN,
+    yView: null,
+    laneGain: 1,
+    stacked: false,
+    fixedY: null,
+    colours: new Uint32Array(0),
+    names: [],
+    unit: "",
+    layer: null,
   };
 }
 
-/** How far behind the newest data the right edge runs: a little over one 20 Hz flush. */
-const DELAY_S = 0.1;
-const PLOT_HEIGHT = 220;
-
-export function Scope({
-  block,
-  output,
-  active,
-  settings,
-  onSettings,
-  tools,
-}: ViewProps<ScopeSettings>): ReactNode {
-  const { rows, cols } = output.shape;
-  const channels = useMemo(
-    () => (settings.channels ?? defaultChannels(cols)).filter((c) => c < cols),
-    [settings.channels, cols],
-  );
-  const matrixMode: MatrixMode = rows > 1 ? settings.matrixMode : "newest";
-  const maxRate = scopeMaxRate(settings.windowS);
-  const statsKey = `scope:${block.name}.${output.name}`;
-  const host = useRef<HTMLDivElement>(null);
-  const [info, setInfo] = useState({ received: 0, skipped: 0 });
-
-  // Everything the frame loop and the data callback share, without React renders.
-  const live = useRef({
-    buffer: null as ScopeBuffer | null,
-    plot: null as uPlot | null,
-    dirty: false,
-    /** Engine time (plot x) minus performance.now() seconds, from the freshest data seen. */
-    offset: NaN,
-    x: [0, 1] as [number, number],
-    y: [-1, 1] as [number, number],
-    sticky: new StickyRange(2),
-    lastDraw: 0,
-    settings,
-    received: 0,
-    skipped: 0,
-    lastInfo: 0,
-    /** The traces to blit (drawn in the frame loop, blitted by uPlot's draw hook). */
-    layer: null as TraceLayer | null,
-    colours: new Uint32Array(0),
-  });
-  live.current.settings = settings;
-
-  // A new channel set or matrix mode: new rings (capacity for the window at the expected rate).
+/** The rings, and the callback that fills them from data messages. */
+function useScopeData(
+  props: ViewProps<ScopeSettings>,
+  channels: number[],
+  matrixMode: MatrixMode,
+  live: { current: ScopeLive },
+  statsKey: string,
+  counts: { current: { received: number; skipped: number } },
+): void {
+  const { block, output, active, settings } = props;
+  const rows = output.shape.rows;
+  const maxRate = scopeMaxRate(settings.windowS, settings.spectrum ? block.desiredRate : 0);
   const expected =
     Math.min(block.desiredRate > 0 ? block.desiredRate : maxRate, maxRate) *
     (matrixMode === "flatten" ? rows : 1);
-  // (The window and rate are read at creation only: the rings grow when they hold too little.)
+  // A new channel set or matrix mode: new rings (capacity for the window at the expected rate;
+  // the window and rate are read at creation only: the rings grow when they hold too little).
   const buffer = useMemo(
     () =>
       new ScopeBuffer(
@@ -164,13 +139,13 @@ export function Scope({
   );
   buffer.windowS = settings.windowS;
   live.current.buffer = buffer;
-
+  const paused = settings.paused;
   const onData = useCallback(
     (m: DataMessage) => {
       const l = live.current;
       const b = l.buffer;
-      if (!b || l.settings.paused) return;
-      b.append(m.t, m.v, m.rows, m.cols, l.settings.matrixMode);
+      if (!b || paused) return;
+      b.append(m.t, m.v, m.rows, m.cols, matrixMode);
       const nowS = performance.now() / 1000;
       const cand = b.newestX - nowS;
       if (!Number.isFinite(l.offset) || cand > l.offset || cand < l.offset - 2) l.offset = cand;
@@ -180,280 +155,241 @@ export function Scope({
       s.messages++;
       s.events += m.t.length;
       s.skipped += m.skipped;
-      l.received += m.t.length;
-      l.skipped += m.skipped;
+      counts.current.received += m.t.length;
+      counts.current.skipped += m.skipped;
     },
-    [statsKey],
+    [statsKey, paused, matrixMode, live, counts],
   );
-  useBlockData(block.name, output.name, onData, active && !settings.paused && cols > 0, maxRate);
+  useBlockData(
+    block.name,
+    output.name,
+    onData,
+    active && !paused && output.shape.cols > 0,
+    maxRate,
+  );
+}
 
-  // The plot: created per channel set, destroyed on unmount.
+/** The view's settings copied where the frame loop reads them (no React render per frame). */
+function syncLive(l: ScopeLive, s: ScopeSettings, output: OutputInfo, channels: number[]): void {
+  l.stacked = s.layout === "stacked" && channels.length > 1;
+  l.fixedY = s.yMode === "fixed" ? [s.yMin, s.yMax] : null;
+  l.names = channels.map((c) => channelLabel(output, c));
+  l.unit = output.unit ?? "";
+}
+
+/** Pause holds the picture's right edge; resume follows the data again. */
+function usePauseHold(live: { current: ScopeLive }, paused: boolean, windowS: number): void {
   useEffect(() => {
-    const el = host.current;
-    if (!el) return undefined;
     const l = live.current;
-    const css = getComputedStyle(el);
-    const fg = css.getPropertyValue("--mp-fg").trim() || "#1d2430";
-    const grid = css.getPropertyValue("--mp-grid").trim() || "rgba(0,0,0,0.08)";
-    const axis = (extra: Partial<uPlot.Axis>): uPlot.Axis => ({
-      stroke: fg,
-      grid: { stroke: grid, width: 1 },
-      ticks: { stroke: grid, width: 1, size: 4 },
-      font: "11px system-ui, sans-serif",
-      ...extra,
-    });
-    l.colours = Uint32Array.from(channels, (c) => colourWord(channelColor(c)));
-    const opts: uPlot.Options = {
-      width: Math.max(100, el.clientWidth),
-      height: PLOT_HEIGHT,
-      legend: { show: false },
-      cursor: { show: false },
-      hooks: {
-        // After the axes and grid: the traces, as one image over the plot area.
-        draw: [
-          (u) => {
-            const t = l.layer;
-            if (t && t.canvas.width === Math.round(u.bbox.width))
-              u.ctx.drawImage(t.canvas, Math.round(u.bbox.left), Math.round(u.bbox.top));
-          },
-        ],
-      },
-      scales: {
-        x: { time: false, range: () => [l.x[0], l.x[1]] },
-        y: { range: () => [l.y[0], l.y[1]] },
-      },
-      axes: [
-        axis({
-          size: 28,
-          values: (_u, splits) => {
-            const step = splits.length > 1 ? Math.abs(splits[1]! - splits[0]!) : 0;
-            return splits.map((v) => `${formatTick(v, step)} s`);
-          },
-        }),
-        axis({
-          size: (_u, values) =>
-            values ? Math.max(3, ...values.map((v) => v.length)) * 6.6 + 12 : 40,
-          values: (_u, splits) => {
-            const step = splits.length > 1 ? Math.abs(splits[1]! - splits[0]!) : 0;
-            return splits.map((v) => formatTick(v, step));
-          },
-        }),
-      ],
-      // One placeholder series on the y scale (so that uPlot ranges it and draws its axis);
-      // the channels are drawn by rasterTraces.
-      series: [{}, { label: "y", stroke: "transparent", points: { show: false } }],
-    };
-    const plot = new uPlot(
-      opts,
-      [
-        [0, 1],
-        [null, null],
-      ],
-      el,
-    );
-    l.plot = plot;
+    l.right = paused ? l.x[1] : NaN;
     l.dirty = true;
-    const ro = new ResizeObserver(() => {
-      const w = Math.max(100, el.clientWidth);
-      if (w !== plot.width) {
-        plot.setSize({ width: w, height: PLOT_HEIGHT });
-        l.dirty = true;
-      }
-    });
-    ro.observe(el);
-    return () => {
-      ro.disconnect();
-      plot.destroy();
-      if (l.plot === plot) l.plot = null;
-    };
-  }, [buffer, channels, output]);
-
-  // Redraw once per frame while there is data or the window scrolls.
+  }, [paused, live]);
   useEffect(() => {
-    if (!active || settings.paused) return undefined;
     const l = live.current;
-    const stats = viewStats(statsKey);
-    return onFrame((now) => {
-      const b = l.buffer;
-      const plot = l.plot;
-      if (!b || !plot || b.count === 0) return;
-      const nowS = now / 1000;
-      const w = l.settings.windowS;
-      const right = Math.min(nowS + l.offset - DELAY_S, b.newestX + 0.5);
-      if (!l.dirty && Math.abs(right - l.x[1]) < w / 4000) return;
-      const t0 = performance.now();
-      const data = b.view(right - w, right);
-      l.x = [right - w, right];
-      if (l.settings.yMode === "fixed") {
-        l.y = [l.settings.yMin, l.settings.yMax];
-        l.sticky.reset();
-      } else {
-        let lo = Infinity;
-        let hi = -Infinity;
-        for (let c = 1; c < data.length; c++) {
-          const [a, z] = finiteExtent(data[c]!);
-          if (a < lo) lo = a;
-          if (z > hi) hi = z;
-        }
-        l.y = l.sticky.update(lo, hi, l.lastDraw ? (now - l.lastDraw) / 1000 : 0);
-      }
-      const bw = Math.round(plot.bbox.width);
-      const bh = Math.round(plot.bbox.height);
-      if (bw > 0 && bh > 0) {
-        if (!l.layer || l.layer.canvas.width !== bw || l.layer.canvas.height !== bh)
-          l.layer = traceLayer(bw, bh);
-        const t = l.layer;
-        if (t) {
-          rasterTraces(
-            { width: bw, height: bh, words: t.words },
-            t.scratch,
-            data[0]!,
-            data.slice(1),
-            l.colours,
-            l.x[0],
-            l.x[1],
-            l.y[0],
-            l.y[1],
-          );
-          t.ctx.putImageData(t.image, 0, 0);
-        }
-      }
-      plot.batch(() => plot.setData([l.x, [null, null]]));
-      l.dirty = false;
-      l.lastDraw = now;
-      countDraw(stats, performance.now() - t0);
-      // The numbers under the plot: 2 renders a second.
-      if (now - l.lastInfo > 500) {
-        l.lastInfo = now;
-        setInfo({ received: l.received, skipped: l.skipped });
-        l.received = 0;
-        l.skipped = 0;
-      }
-    });
-  }, [active, settings.paused, statsKey]);
+    l.span = windowS;
+    l.dirty = true;
+  }, [windowS, live]);
+}
 
+function Footer({
+  props,
+  channels,
+  matrixMode,
+  info,
+}: {
+  props: ViewProps<ScopeSettings>;
+  channels: number[];
+  matrixMode: MatrixMode;
+  info: { received: number; skipped: number };
+}): ReactNode {
+  const { settings, active, output } = props;
+  const { rows, cols } = output.shape;
   const shownPerS = info.received * 2;
   const totalPerS = (info.received + info.skipped) * 2;
+  if (settings.paused)
+    return (
+      <p className="mp-foot">
+        paused — no data is watched: wheel zooms (Shift: amplitude), drag pans, double-click resets
+      </p>
+    );
+  if (!(totalPerS > 0))
+    return <p className="mp-foot">{active ? "waiting for data…" : "hidden: no data is watched"}</p>;
   return (
-    <div className="mp-scope" data-view="scope" data-block={block.name} data-port={output.name}>
-      <div className="mp-toolbar" role="toolbar" aria-label="Scope settings">
-        {tools}
-        <button
-          type="button"
-          className={`mp-btn${settings.paused ? " mp-on" : ""}`}
-          aria-pressed={settings.paused}
-          onClick={() => onSettings({ paused: !settings.paused })}
-          title={
-            settings.paused
-              ? "Resume: watch the data again"
-              : "Pause: freeze the picture (stops the data)"
-          }
-        >
-          <PlayPauseIcon paused={settings.paused} /> {settings.paused ? "Resume" : "Pause"}
-        </button>
-        <label className="mp-field">
-          Window
-          <select
-            value={settings.windowS}
-            onChange={(e) => onSettings({ windowS: Number(e.target.value) })}
+    <p className="mp-foot">
+      {totalPerS.toFixed(0)} events/s
+      {info.skipped > 0
+        ? `, plotting 1 in ${Math.round(totalPerS / Math.max(1, shownPerS))} (${shownPerS.toFixed(0)}/s)`
+        : ""}
+      {" · "}
+      {channels.length} of {cols} channels
+      {rows > 1
+        ? ` · ${matrixMode === "newest" ? "newest row" : "all rows"} of each [${rows}, ${cols}] event`
+        : ""}
+    </p>
+  );
+}
+
+function Legend({
+  output,
+  channels,
+  onSettings,
+}: {
+  output: OutputInfo;
+  channels: number[];
+  onSettings: (p: Partial<ScopeSettings>) => void;
+}): ReactNode {
+  return (
+    <div className="mp-legend" aria-label="Channels">
+      {channels.length <= 32 ? (
+        channels.map((c) => (
+          <button
+            type="button"
+            key={c}
+            className="mp-chip"
+            title={`Hide channel ${channelLabel(output, c)}`}
+            onClick={() => onSettings({ channels: channels.filter((x) => x !== c) })}
           >
-            {WINDOWS_S.map((w) => (
-              <option key={w} value={w}>
-                {w} s
-              </option>
-            ))}
-          </select>
-        </label>
-        <label className="mp-field">
-          Y
-          <select
-            value={settings.yMode}
-            onChange={(e) => onSettings({ yMode: e.target.value as "auto" | "fixed" })}
-          >
-            <option value="auto">auto</option>
-            <option value="fixed">fixed</option>
-          </select>
-        </label>
-        {settings.yMode === "fixed" && (
-          <RangeInputs
-            min={settings.yMin}
-            max={settings.yMax}
-            onChange={(yMin, yMax) => onSettings({ yMin, yMax })}
-            suggest={() => live.current.y}
-          />
-        )}
-        {rows > 1 && (
-          <label
-            className="mp-field"
-            title={`Each event is a [${rows}, ${cols}] matrix (e.g. a window)`}
-          >
-            Rows
-            <select
-              value={matrixMode}
-              onChange={(e) => onSettings({ matrixMode: e.target.value as MatrixMode })}
-            >
-              <option value="newest">newest row</option>
-              <option value="flatten">all rows, in time order</option>
-            </select>
-          </label>
-        )}
-        <ChannelPicker
-          count={cols}
-          selected={channels}
-          output={output}
-          onChange={(c) => onSettings({ channels: c })}
+            <span
+              className="mp-swatch"
+              style={{ background: channelColor(c) }}
+              aria-hidden="true"
+            />
+            {channelLabel(output, c)}
+          </button>
+        ))
+      ) : (
+        <span className="mp-muted">{channels.length} channels (colours repeat in hue)</span>
+      )}
+      {output.unit ? <span className="mp-muted mp-unit">values in {output.unit}</span> : null}
+    </div>
+  );
+}
+
+export function Scope(props: ViewProps<ScopeSettings>): ReactNode {
+  const { block, output, active, settings, onSettings, tools } = props;
+  const { rows, cols } = output.shape;
+  const channels = useMemo(
+    () => (settings.channels ?? defaultChannels(cols)).filter((c) => c < cols),
+    [settings.channels, cols],
+  );
+  const matrixMode: MatrixMode = rows > 1 ? settings.matrixMode : "newest";
+  const statsKey = `scope:${block.name}.${output.name}`;
+  const host = useRef<HTMLDivElement>(null);
+  const readout = useRef<HTMLDivElement>(null);
+  const cursor = useRef<HTMLDivElement>(null);
+  const pointer = useRef<number | null>(null);
+  const [info, setInfo] = useState({ received: 0, skipped: 0 });
+  const [zoomed, setZoomed] = useState(false);
+  const counts = useRef({ received: 0, skipped: 0, lastInfo: 0 });
+  const live = useRef<ScopeLive>(newLive(settings));
+  syncLive(live.current, settings, output, channels);
+  useScopeData(props, channels, matrixMode, live, statsKey, counts);
+  usePauseHold(live, settings.paused, settings.windowS);
+  const stacked = live.current.stacked;
+
+  const updateReadout = useCallback(() => {
+    const l = live.current;
+    const px = pointer.current;
+    if (!readout.current || !cursor.current || !l.plot) return;
+    const lines = px === null ? null : readoutLines(l, l.plot, px);
+    showReadout(readout.current, cursor.current, lines, px ?? 0, l.plot.over.offsetLeft);
+  }, []);
+  // What the pointer handlers read (they are wired once per plot, not per render).
+  const latest = useRef({ windowS: settings.windowS, onSettings });
+  latest.current = { windowS: settings.windowS, onSettings };
+  const resetZoom = useCallback(() => {
+    const l = live.current;
+    l.span = latest.current.windowS;
+    l.yView = null;
+    l.laneGain = 1;
+    l.dirty = true;
+    setZoomed(false);
+  }, []);
+  const attach = useCallback(
+    (u: uPlot) =>
+      attachPointer(
+        u,
+        live.current,
+        () => Math.max(latest.current.windowS, live.current.span),
+        (px) => {
+          pointer.current = px;
+          updateReadout();
+        },
+        {
+          onView: () => setZoomed(isZoomed(live.current, latest.current.windowS)),
+          onHold: () => latest.current.onSettings({ paused: true }),
+          onReset: resetZoom,
+        },
+      ),
+    [resetZoom, updateReadout],
+  );
+  useEffect(() => {
+    live.current.colours = Uint32Array.from(channels, (c) => colourWord(channelColor(c)));
+    live.current.dirty = true;
+  }, [channels]);
+  usePlot(host, live, attach, [channels, output, stacked, output.unit, attach]);
+  const afterDraw = useCallback(
+    (now: number) => {
+      if (pointer.current !== null) updateReadout();
+      const c = counts.current;
+      // The numbers under the plot: 2 renders a second.
+      if (now - c.lastInfo > 500) {
+        c.lastInfo = now;
+        setInfo({ received: c.received, skipped: c.skipped });
+        c.received = 0;
+        c.skipped = 0;
+      }
+    },
+    [updateReadout],
+  );
+  useDrawLoop(live, active, statsKey, afterDraw);
+
+  return (
+    <div
+      className="mp-scope"
+      data-view="scope"
+      data-block={block.name}
+      data-port={output.name}
+      data-layout={stacked ? "stacked" : "overlaid"}
+    >
+      <ScopeToolbar
+        settings={settings}
+        onSettings={onSettings}
+        output={output}
+        channels={channels}
+        matrixMode={matrixMode}
+        zoomed={zoomed}
+        onResetZoom={resetZoom}
+        onCsv={() => downloadCsv(live.current, block.name, output.name)}
+        onPng={() => {
+          const c = live.current.plot?.ctx.canvas;
+          if (c) downloadPng(c, live.current.names, channels, block.name, output.name);
+        }}
+        suggestY={() => live.current.y}
+        tools={tools}
+      />
+      <div className="mp-plot-box">
+        <div
+          className="mp-plot mp-resizable"
+          ref={host}
+          style={{ height: defaultPlotHeight(stacked, channels.length) }}
+          aria-label={`Scope of ${block.name}.${output.name}`}
+          role="img"
+        />
+        <div ref={cursor} className="mp-cursor" hidden aria-hidden="true" />
+        <div
+          ref={readout}
+          className="mp-readout"
+          hidden
+          role="status"
+          aria-label="Values under the cursor"
         />
       </div>
-      <div
-        className="mp-plot"
-        ref={host}
-        style={{ height: PLOT_HEIGHT }}
-        aria-label={`Scope of ${block.name}.${output.name}`}
-        role="img"
-      />
-      <div className="mp-legend" aria-label="Channels">
-        {channels.length <= 32 ? (
-          channels.map((c) => (
-            <button
-              type="button"
-              key={c}
-              className="mp-chip"
-              title={`Hide channel ${channelLabel(output, c)}`}
-              onClick={() => onSettings({ channels: channels.filter((x) => x !== c) })}
-            >
-              <span
-                className="mp-swatch"
-                style={{ background: channelColor(c) }}
-                aria-hidden="true"
-              />
-              {channelLabel(output, c)}
-            </button>
-          ))
-        ) : (
-          <span className="mp-muted">{channels.length} channels (colours repeat in hue)</span>
-        )}
-      </div>
-      <p className="mp-foot">
-        {settings.paused ? (
-          "paused — the picture is frozen and no data is watched"
-        ) : totalPerS > 0 ? (
-          <>
-            {totalPerS.toFixed(0)} events/s
-            {info.skipped > 0
-              ? `, plotting 1 in ${Math.round(totalPerS / Math.max(1, shownPerS))} (${shownPerS.toFixed(0)}/s)`
-              : ""}
-            {" · "}
-            {channels.length} of {cols} channels
-            {rows > 1
-              ? ` · ${matrixMode === "newest" ? "newest row" : "all rows"} of each [${rows}, ${cols}] event`
-              : ""}
-          </>
-        ) : active ? (
-          "waiting for data…"
-        ) : (
-          "hidden: no data is watched"
-        )}
-      </p>
+      <Legend output={output} channels={channels} onSettings={onSettings} />
+      {settings.spectrum && (
+        <ScopeSpectrum live={live} channels={channels} names={live.current.names} active={active} />
+      )}
+      <Footer props={props} channels={channels} matrixMode={matrixMode} info={info} />
     </div>
   );
 }

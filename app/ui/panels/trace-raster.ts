@@ -34,7 +34,8 @@ export function rgbaWord(r: number, g: number, b: number, a = 255): number {
 /**
  * Clears `img` (transparent) and draws channel c of `ys` (times `xs`, ascending) in colour
  * `colours[c]`, later channels on top. The x range [x0, x1] spans the image's width and the y
- * range [y0, y1] its height (y1 at the top row). Non-finite values leave a gap.
+ * range [y0, y1] its height (y1 at the top row). Non-finite values leave a gap. With `clear`
+ * false the image keeps what it holds (stacked lanes draw into bands of one image).
  */
 export function rasterTraces(
   img: TraceImage,
@@ -46,9 +47,10 @@ export function rasterTraces(
   x1: number,
   y0: number,
   y1: number,
+  clear = true,
 ): void {
   const { width: W, height: H, words } = img;
-  words.fill(0);
+  if (clear) words.fill(0);
   if (W <= 0 || H <= 0 || !(x1 > x0) || !(y1 > y0)) return;
   const lo = scratch.lo;
   const hi = scratch.hi;
