@@ -46,6 +46,11 @@ async function serve(): Promise<{ cli: ChildProcess; url: string }> {
   return { cli, url };
 }
 
+/** Waits (generously: the machine may be loaded) until the page shows the running demo. */
+async function running(page: Page): Promise<void> {
+  await page.waitForSelector('.app[data-engine-state="running"]', { timeout: 60_000 });
+}
+
 /** Opens the Amplification block's params form (its panel opened from the graph node). */
 async function openParams(page: Page): Promise<void> {
   if ((await page.locator(PANEL).count()) === 0)
@@ -64,7 +69,7 @@ async function setValue(page: Page, v: number): Promise<void> {
 async function expectValue(page: Page, v: number): Promise<void> {
   const input = JSON.stringify(`${VALUE} input`);
   await page.waitForFunction(`document.querySelector(${input})?.value === "${v}"`, undefined, {
-    timeout: 15_000,
+    timeout: 30_000,
   });
 }
 
@@ -75,7 +80,7 @@ async function expectShown(page: Page, v: number, changed: boolean): Promise<voi
     `document.querySelector(${JSON.stringify(VALUE)})?.getAttribute("data-changed") === "${changed}" && ` +
       `(document.querySelector(${JSON.stringify(NODE_MARK)}) !== null) === ${changed}`,
     undefined,
-    { timeout: 15_000 },
+    { timeout: 30_000 },
   );
 }
 
@@ -96,11 +101,13 @@ describe.skipIf(!haveChromium)("live params on mosaic serve (two tabs)", () => {
     requireBuild();
     ({ cli, url } = await serve());
     browser = await launchChromium();
-    a = await openApp(browser, url);
-    b = await openApp(browser, url);
+    a = await openApp(browser, url, undefined, { waitRunning: false });
+    b = await openApp(browser, url, undefined, { waitRunning: false });
+    await running(a.page);
+    await running(b.page);
     await openParams(a.page);
     await openParams(b.page);
-  }, 90_000);
+  }, 180_000);
 
   afterAll(async () => {
     await browser?.close();
@@ -126,7 +133,7 @@ describe.skipIf(!haveChromium)("live params on mosaic serve (two tabs)", () => {
     await setValue(b.page, 7);
     await expectShown(a.page, 7, true);
     await b.page.reload();
-    await b.page.waitForSelector('.app[data-engine-state="running"]', { timeout: 15_000 });
+    await running(b.page);
     await openParams(b.page);
     await expectShown(b.page, 7, true);
 
@@ -136,7 +143,7 @@ describe.skipIf(!haveChromium)("live params on mosaic serve (two tabs)", () => {
     await expectShown(b.page, 5, false);
     expect(a.errors).toEqual([]);
     expect(b.errors).toEqual([]);
-  }, 120_000);
+  }, 180_000);
 
   test("Save layout says which live values it leaves out", async () => {
     await setValue(a.page, 100);
@@ -146,9 +153,9 @@ describe.skipIf(!haveChromium)("live params on mosaic serve (two tabs)", () => {
     await a.page.waitForFunction(
       `/not the live values \\(Amplification\\.Value = 100\\)/.test(document.querySelector(".notice")?.textContent ?? "")`,
       undefined,
-      { timeout: 10_000 },
+      { timeout: 30_000 },
     );
-  }, 60_000);
+  }, 180_000);
 
   test("write-back: the file gets the value, comments kept; the markers clear in both tabs", async () => {
     await expectShown(b.page, 100, true);
@@ -162,13 +169,14 @@ describe.skipIf(!haveChromium)("live params on mosaic serve (two tabs)", () => {
     await expectShown(a.page, 100, false);
     await expectShown(b.page, 100, false);
     // A tab opened now has the written text too (its Save layout keeps the value).
-    const c = await openApp(browser, url);
+    const c = await openApp(browser, url, undefined, { waitRunning: false });
+    await running(c.page);
     const saved = await downloadText(c.page, () => c.page.click("button:has-text('Save layout')"));
     expect(saved).toContain("Operation: multiply, Value: 100 }");
     expect(saved).toContain("# Paper Table 5 chain: amplification, rectification");
     expect([...a.errors, ...b.errors, ...c.errors]).toEqual([]);
     await c.close();
-  }, 60_000);
+  }, 180_000);
   test("edit mode: Take live values sets them in the text; its Save clears the markers", async () => {
     await setValue(b.page, 42);
     await expectShown(a.page, 42, true);
@@ -193,5 +201,26 @@ describe.skipIf(!haveChromium)("live params on mosaic serve (two tabs)", () => {
     );
     await expectShown(b.page, 42, false);
     expect([...a.errors, ...b.errors]).toEqual([]);
-  }, 60_000);
+  }, 180_000);
+  test("loading the same file again (a fixed param changed while stopped) keeps the live values", async () => {
+    const { page } = a;
+    if ((await page.locator(".editor").count()) > 0)
+      await page.click('.editor__bar button:has-text("Done")');
+    await setValue(b.page, 100);
+    await expectShown(b.page, 100, true);
+    await page.click('header button:has-text("Stop")');
+    await page.waitForSelector('.app[data-engine-state="stopped"]');
+    await openParams(page);
+    // A fixed param: the page edits the file's text and loads it again.
+    await page.selectOption(`${PANEL} [data-param="Operation"] select`, "add");
+    await page.waitForFunction(
+      `document.querySelector(".notice")?.textContent.includes("pipeline reloaded")`,
+      undefined,
+      { timeout: 30_000 },
+    );
+    await openParams(page);
+    await expectShown(page, 100, true);
+    await expectShown(b.page, 100, true);
+    expect([...a.errors, ...b.errors]).toEqual([]);
+  }, 180_000);
 });

@@ -263,7 +263,7 @@ function Shell({
       } catch (e) {
         return { ok: false, message: (e as Error).message };
       }
-      const r = await current.current.loadSource(file, text, false);
+      const r = await current.current.loadSource(file, text, false, true);
       if (r.ok) {
         notify(
           `${param} = ${JSON.stringify(value)}: pipeline reloaded (Start to run it)`,
@@ -274,7 +274,7 @@ function Shell({
       }
       const why =
         r.diagnostics?.find((d) => d.severity === "error")?.message ?? r.message ?? "failed";
-      await current.current.loadSource(file, source, false);
+      await current.current.loadSource(file, source, false, true);
       return { ok: false, message: why };
     },
     [client, notify],
@@ -332,7 +332,7 @@ function Shell({
 
   const start = (): void => {
     if (state === "finished" && pipeline.file !== undefined && pipeline.source !== undefined) {
-      void pipeline.loadSource(pipeline.file, pipeline.source);
+      void pipeline.loadSource(pipeline.file, pipeline.source, true, true);
     } else void client.start();
   };
 
@@ -468,7 +468,7 @@ function Shell({
                 const on = e.target.checked;
                 pipeline.setSimulateDevices(on);
                 if (pipeline.file !== undefined && pipeline.source !== undefined) {
-                  void pipeline.loadSource(pipeline.file, pipeline.source, running);
+                  void pipeline.loadSource(pipeline.file, pipeline.source, running, true);
                 }
               }}
             />

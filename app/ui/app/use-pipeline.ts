@@ -7,6 +7,7 @@
 import { useCallback, useEffect, useRef, useState } from "react";
 import type { GraphInfo } from "../../engine/protocol";
 import type { EngineClient, Reply } from "../client/engine-client";
+import { keptChanges, liveChanges, type LiveChange } from "../editor/live-values";
 import type { LoadReport } from "./log-book";
 import {
   afterLoad,
@@ -73,12 +74,17 @@ export function usePipeline(client: EngineClient, initial: string, simulateDevic
     };
   }, []);
 
-  /** Loads `file` with `source` (already read) and starts it when it loads. */
+  /**
+   * Loads `file` with `source` (already read) and starts it when it loads. `keepLive`: the same
+   * file loaded again keeps the live values changed since it was loaded (see keptChanges).
+   */
   const loadSource = useCallback(
-    async (file: string, source: string, autostart = true): Promise<Reply> => {
+    async (file: string, source: string, autostart = true, keepLive = false): Promise<Reply> => {
       const ticket = ++busy.current;
+      const live = keepLive && file === current.current.file ? liveChanges(client.graph) : [];
       setS((p) => ({ ...p, loading: true }));
       const r = await client.load(file, source, simulate.current);
+      if (r.ok) await setAgain(client, keptChanges(live, r.graph));
       if (ticket !== busy.current) return { ok: false, message: "another load started" };
       const kept = client.state !== "empty";
       const replaced = !keepsRunning(current.current, r, kept);
@@ -177,6 +183,11 @@ export function usePipeline(client: EngineClient, initial: string, simulateDevic
     onLoadReport,
     dismissRejected,
   };
+}
+
+/** Sets live values in the engine again (after the pipeline was loaded again). */
+async function setAgain(client: EngineClient, changes: LiveChange[]): Promise<void> {
+  for (const c of changes) await client.setParam(c.block, c.param, c.value);
 }
 
 function rejectedRead(file: string, error: string): Rejected {

@@ -5,6 +5,7 @@ import {
   applyLiveValues,
   changedParams,
   describeChanges,
+  keptChanges,
   liveChanges,
   missingFromText,
   presentInText,
@@ -149,5 +150,28 @@ describe("live values against the editor's text", () => {
     expect(r.written).toHaveLength(1);
     expect(r.skipped).toHaveLength(1);
     expect(doc.toString()).toBe(DEMO.replace("Value: 5 }", "Value: 100 }"));
+  });
+});
+
+describe("live values across a reload of the same file", () => {
+  test("kept: the block still has the live param and the file's value did not change", () => {
+    const graph: GraphInfo = {
+      file: "demo.yaml",
+      blocks: [
+        block({ name: "A", live: ["Value"], params: { Value: 5 }, fileParams: { Value: 5 } }),
+        block({ name: "B", live: ["Value"], params: { Value: 9 }, fileParams: { Value: 9 } }),
+        block({ name: "C", live: [], params: { Value: 1 }, fileParams: {} }),
+      ],
+    };
+    const c = (name: string, value: unknown, file: unknown) => ({
+      block: name,
+      param: "Value",
+      value,
+      file,
+    });
+    expect(
+      keptChanges([c("A", 100, 5), c("B", 100, 5), c("C", 2, 1), c("Gone", 1, 0)], graph),
+    ).toEqual([c("A", 100, 5)]);
+    expect(keptChanges([c("A", 100, 5)], undefined)).toEqual([]);
   });
 });

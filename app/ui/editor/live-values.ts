@@ -102,6 +102,28 @@ export function presentInText(
   return changes.filter((c) => hasValue(blocks, c));
 }
 
+/**
+ * The changes of a pipeline loaded again (the same file: a fixed param edited, Start after it
+ * finished, Simulate devices switched) that still apply to the new graph: the block has the live
+ * param and the file's value of it did not change. The engine gets them again, so a reload does
+ * not silently drop live values.
+ */
+export function keptChanges(
+  changes: readonly LiveChange[],
+  graph: GraphInfo | undefined,
+): LiveChange[] {
+  const by = new Map((graph?.blocks ?? []).map((b) => [b.name, b]));
+  return changes.filter((c) => {
+    const b = by.get(c.block);
+    return (
+      b !== undefined &&
+      b.live.includes(c.param) &&
+      b.fileParams !== undefined &&
+      deepEqual(b.fileParams[c.param], c.file)
+    );
+  });
+}
+
 /** "Amplification.Value = 100, Emg.Gain = 2" (at most `max` named, then "and N more"). */
 export function describeChanges(changes: readonly LiveChange[], max = 3): string {
   const named = changes
