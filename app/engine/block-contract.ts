@@ -390,13 +390,18 @@ const ContractSource = defineBlock({
   },
 });
 
-function garbagePipeline(def: AnyBlockDefinition, inputs: Input[], params: unknown): string {
-  const lines = ["Clock: { Type: ScheduledTimer, DesiredRate: 100 }"];
+function garbagePipeline(
+  def: AnyBlockDefinition,
+  inputs: Input[],
+  params: unknown,
+  timer: string,
+): string {
+  const lines = [`Clock: { Type: ${timer}, DesiredRate: 100 }`];
   const names = inputs.map((inp, i) => {
     const name = `Src${i}`;
     lines.push(
       inp.isTimer
-        ? `${name}: { Type: ScheduledTimer, DesiredRate: ${inp.rate} }`
+        ? `${name}: { Type: ${timer}, DesiredRate: ${inp.rate} }`
         : `${name}: { Type: ContractSource, DesiredRate: ${inp.rate}, Inputs: [Clock], Params: { Rows: ${inp.shape.rows}, Cols: ${inp.shape.cols} } }`,
     );
     return name;
@@ -471,7 +476,10 @@ async function tryGarbage(r: Run, params: unknown, found: string[]): Promise<voi
     guarded(r.def, found),
     ContractSource,
   ]);
-  const loaded = loadPipeline(garbagePipeline(r.def, r.inputs, params), "garbage.yaml", catalog);
+  // The base catalog's timer (ScheduledTimer among the built-in blocks).
+  const timer = [...r.base.values()].find((d) => d.timer === true)?.type ?? "ScheduledTimer";
+  const text = garbagePipeline(r.def, r.inputs, params, timer);
+  const loaded = loadPipeline(text, "garbage.yaml", catalog);
   if (!loaded.spec) return;
   const clock = new VirtualClock(0);
   const created = await Runtime.create({
