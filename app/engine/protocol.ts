@@ -7,6 +7,7 @@
 import { z } from "zod";
 import type { PortMeta } from "./block";
 import type { Diagnostic } from "./diagnostics";
+import { MAX_FOLDER_FILES } from "./protocol-folder";
 import type { Shape } from "./frame";
 import type { PipelineLayout } from "./pipeline/pipeline-layout";
 import type { RuntimeEvent, Telemetry } from "./runtime/runtime";
@@ -24,6 +25,14 @@ export const PROTOCOL_VERSIONS: readonly number[] = [PROTOCOL_VERSION];
 // UI → engine
 
 const id = z.number().int().nonnegative();
+/**
+ * The pipeline came from this computer (the browser build's Open file… / Open folder…): the
+ * files of its folder, path → a URL the in-page engine reads (app/engine/protocol-folder.ts);
+ * empty when the browser did not say which folder. Engines that read files themselves ignore it.
+ */
+const localFolder = z
+  .record(z.string().max(4096), z.string().max(4096))
+  .refine((f) => Object.keys(f).length <= MAX_FOLDER_FILES, "too many files");
 
 export const uiMessageSchema = z.discriminatedUnion("type", [
   z.strictObject({ type: z.literal("hello"), version: z.number().int() }),
@@ -38,6 +47,7 @@ export const uiMessageSchema = z.discriminatedUnion("type", [
      * counting sinks (app/engine/pipeline/simulate.ts); default false.
      */
     simulateDevices: z.boolean().optional(),
+    folder: localFolder.optional(),
   }),
   /** The diagnostics `mosaic validate` gives for this text (the editor's); loads nothing. */
   z.strictObject({
@@ -45,6 +55,7 @@ export const uiMessageSchema = z.discriminatedUnion("type", [
     id,
     file: z.string().min(1).max(4096),
     source: z.string().max(4_000_000),
+    folder: localFolder.optional(),
   }),
   z.strictObject({ type: z.literal("start"), id }),
   /** Every block type the engine knows, with its metadata (the editor's palette and forms). */

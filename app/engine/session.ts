@@ -11,6 +11,7 @@ import { errorMessage, type Diagnostic } from "./diagnostics";
 import type { Frame } from "./frame";
 import { loadPipeline, type LoadResult, type PipelineSpec } from "./pipeline/loader";
 import { withSimulatedDevices } from "./pipeline/simulate";
+import type { LocalFolder } from "./protocol-folder";
 import {
   PROTOCOL_VERSION,
   PROTOCOL_VERSIONS,
@@ -52,8 +53,11 @@ export interface SessionPlatform {
   engine: string;
   sharedMemory: boolean;
   clock(): Clock;
-  /** File access relative to the pipeline file's folder. */
-  resources(file: string): Resources;
+  /**
+   * File access relative to the pipeline file's folder; `folder`: the files of the folder a page
+   * opened the file from (the browser build; hosts that read files ignore it).
+   */
+  resources(file: string, folder?: LocalFolder): Resources;
   logs?(file: string): LogSink | undefined;
   /**
    * Parses and validates a pipeline file off this thread (the Node host's loader thread, so that
@@ -313,7 +317,7 @@ export class EngineSession {
       case "load": {
         // One load at a time: a load may wait for its parse (platform.loadPipeline).
         const run = this.loading.then(() =>
-          this.load(msg.file, msg.source, msg.simulateDevices === true),
+          this.load(msg.file, msg.source, msg.simulateDevices === true, msg.folder),
         );
         this.loading = run.catch(() => {});
         const { diagnostics, graph } = await run;
@@ -331,7 +335,7 @@ export class EngineSession {
         const diagnostics = own.failed
           ? own.diagnostics
           : await validatePipeline(msg.source, msg.file, own.catalog, {
-              resources: this.platform.resources(msg.file),
+              resources: this.platform.resources(msg.file, msg.folder),
               ...(parse ? { parse: (text, f) => parse(text, f, own.catalog) } : {}),
             });
         this.reply(msg.id, true, undefined, { diagnostics });
@@ -428,6 +432,7 @@ export class EngineSession {
     file: string,
     source: string,
     simulateDevices = false,
+    folder?: LocalFolder,
   ): Promise<{ diagnostics: Diagnostic[]; graph?: GraphInfo }> {
     const own = await this.ownBlocks(source, file);
     if (own.failed) return this.rejected(own.diagnostics);
@@ -437,7 +442,7 @@ export class EngineSession {
     const loaded = withSimulatedDevices(parsed, own.catalog, simulateDevices ? {} : undefined);
     // A text that does not load leaves what runs running (issue 17, defect 4).
     if (!loaded.spec) return this.rejected(loaded.diagnostics);
-    const rejected = await this.precheck(loaded.spec, file);
+    const rejected = await this.precheck(loaded.spec, file, folder);
     if (rejected.length > 0) return this.rejected([...loaded.diagnostics, ...rejected]);
     this.unload();
     this.file = file;
@@ -448,7 +453,7 @@ export class EngineSession {
       catalog: this.catalog,
       clock: this.platform.clock(),
       virtual: false,
-      resources: this.platform.resources(file),
+      resources: this.platform.resources(file, folder),
       ...(logs ? { logs } : {}),
       ...(this.platform.io ? { io: this.platform.io } : {}),
       ignorePlacement: true,
@@ -477,14 +482,18 @@ export class EngineSession {
    * While a pipeline is loaded, the blocks of its replacement are first instantiated on a
    * virtual clock (as `validate` does) so that one that cannot be created does not stop it.
    */
-  private async precheck(spec: PipelineSpec, file: string): Promise<Diagnostic[]> {
+  private async precheck(
+    spec: PipelineSpec,
+    file: string,
+    folder?: LocalFolder,
+  ): Promise<Diagnostic[]> {
     if (!this.rt) return [];
     const created = await Runtime.create({
       spec,
       catalog: this.catalog,
       clock: new VirtualClock(0),
       virtual: true,
-      resources: this.platform.resources(file),
+      resources: this.platform.resources(file, folder),
       ignorePlacement: true,
     });
     created.runtime?.dispose();

@@ -11,6 +11,7 @@ import type { FileWriteHandle, Resources } from "../engine/block";
 import { MonotonicClock } from "../engine/clock";
 import { initDsp } from "../engine/dsp";
 import type { EngineMessage } from "../engine/protocol";
+import { resolveInFolder, type LocalFolder } from "../engine/protocol-folder";
 import { MemoryFile } from "../engine/recording/memory-file";
 import { CoarseLoop } from "../engine/runtime/coarse-loop";
 import { RealtimeLoop } from "../engine/runtime/loop";
@@ -68,16 +69,27 @@ function downloadOnClose(p: string): FileWriteHandle {
   };
 }
 
-/** Files are fetched relative to the pipeline file's URL (pipelines and their data are static). */
-function fetchResources(file: string): Resources {
+/**
+ * Files are fetched relative to the pipeline file's URL (pipelines and their data are static);
+ * for a pipeline opened from this computer, from the files of its folder that the page handed
+ * over (app/engine/protocol-folder.ts: one clear error when the file is not there).
+ */
+function fetchResources(file: string, folder?: LocalFolder): Resources {
   const base = new URL(file, self.location.href);
-  const resolve = (p: string): string => new URL(p, base).href;
+  const where = (p: string) =>
+    folder
+      ? resolveInFolder(folder, file, p)
+      : { ok: true as const, path: p, url: new URL(p, base).href };
   return {
-    resolve,
+    resolve: (p) => {
+      const w = where(p);
+      return w.ok && !folder ? w.url : w.path;
+    },
     async readText(p: string) {
-      const url = resolve(p);
-      const r = await fetch(url);
-      if (!r.ok) throw new Error(`cannot read ${url}: HTTP ${r.status}`);
+      const w = where(p);
+      if (!w.ok) throw new Error(w.message);
+      const r = await fetch(w.url);
+      if (!r.ok) throw new Error(`cannot read ${w.path}: HTTP ${r.status}`);
       return r.text();
     },
     // No files here: a recorder block's file is kept in memory and downloaded when it closes.

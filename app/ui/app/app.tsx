@@ -18,6 +18,7 @@ import { ConnectionLost, EngineBadge, useConnectionLoss, type LossSource } from 
 import { EventLog } from "./event-log";
 import { GestureLegend, useGestureKeys } from "./gestures";
 import { setBlockParam } from "../graph/layout-yaml";
+import { OpenLocal } from "./open-local";
 import { PanelHost, type EditStatic, type OpenPanel } from "./panel-host";
 import { PresentationToggle } from "./presentation";
 import { RecordControl } from "./record";
@@ -323,13 +324,6 @@ function Shell({
     window.history.replaceState(null, "", url);
   };
 
-  const onOpenFile = async (e: React.ChangeEvent<HTMLInputElement>): Promise<void> => {
-    const f = e.target.files?.[0];
-    e.target.value = "";
-    if (!f) return;
-    await pipeline.loadSource(f.name, await f.text());
-  };
-
   const start = (): void => {
     if (state === "finished" && pipeline.file !== undefined && pipeline.source !== undefined) {
       void pipeline.loadSource(pipeline.file, pipeline.source, true, true);
@@ -402,15 +396,11 @@ function Shell({
           >
             Load
           </button>
-          <label className="button file-open" title="Load a pipeline file from this computer">
-            Open file…
-            <input
-              type="file"
-              accept=".yaml,.yml,text/yaml"
-              className="sr-only"
-              onChange={(e) => void onOpenFile(e)}
-            />
-          </label>
+          <OpenLocal
+            inPage={engine.kind === "page"}
+            onOpen={(file, text) => pipeline.loadSource(file, text)}
+            notify={notify}
+          />
           <span className="toolbar__sep" aria-hidden="true" />
           <button
             type="button"

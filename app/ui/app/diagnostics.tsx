@@ -39,6 +39,7 @@ export function Diagnostics({
               {d.line > 0 ? `${d.file}:${d.line}:${d.col}` : d.file}
             </code>
             <span className="diagnostic__message">
+              {d.param !== undefined ? <code className="diagnostic__param">{d.param}</code> : null}
               {d.message}
               {d.expected !== undefined ? <> (expected {d.expected})</> : null}
             </span>

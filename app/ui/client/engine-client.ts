@@ -15,6 +15,7 @@ import type {
   RecordingStatus,
   UiMessage,
 } from "../../engine/protocol";
+import type { LocalFolder } from "../../engine/protocol-folder";
 import type { Diagnostic } from "../../engine/diagnostics";
 import type { RuntimeEvent, Telemetry } from "../../engine/runtime/runtime";
 
@@ -66,6 +67,16 @@ export class EngineClient {
   sharedMemory = false;
   /** True once the engine answered `hello`. */
   connected = false;
+  /** Pipelines opened from this computer (in-page engine): the files of their folders. */
+  private readonly localFolders = new Map<string, LocalFolder>();
+
+  /**
+   * `file` came from this computer with the files of its folder (empty: the browser did not say
+   * which): its loads and checks carry them, so the engine reads what the file names next to it.
+   */
+  openedLocally(file: string, folder: LocalFolder): void {
+    this.localFolders.set(file, folder);
+  }
 
   constructor(readonly connection: EngineConnection) {
     this.off = connection.onMessage((m) => this.receive(m));
@@ -124,7 +135,11 @@ export class EngineClient {
     const id = this.nextId++;
     return new Promise((resolve) => {
       this.pending.set(id, resolve);
-      this.connection.send({ ...msg, id } as UiMessage);
+      const folder =
+        msg.type === "load" || msg.type === "validate"
+          ? this.localFolders.get(msg.file)
+          : undefined;
+      this.connection.send({ ...msg, ...(folder ? { folder } : {}), id } as UiMessage);
     });
   }
 
