@@ -140,6 +140,8 @@ const platform: SessionPlatform = {
   resources: fetchResources,
   // Recordings are kept in memory (no openWrite) and downloaded when they stop.
   recordingFormats: sessionRecordingFormats,
+  // Users' block modules served beside the pipeline (self-contained JavaScript).
+  blockModules: loadBrowserBlockModule,
   startLoop,
   post: (msg: EngineMessage, transfer?: ArrayBuffer[]) => self.postMessage(msg, transfer ?? []),
 };
@@ -152,8 +154,6 @@ async function boot(): Promise<void> {
   if (!r.ok) throw new Error(`cannot load the DSP core: HTTP ${r.status}`);
   initDsp(await r.arrayBuffer());
   session = new EngineSession(catalog, platform);
-  // Users' block modules served beside the pipeline (self-contained JavaScript).
-  blockModules: loadBrowserBlockModule,
   for (const m of pending.splice(0)) await session.handle(m);
 }
 
