@@ -196,8 +196,11 @@ function BlockNodeComponent({ data }: NodeProps<BlockNodeType>) {
   );
 }
 
-/** "changed": live params the engine runs with values other than the file's (issue 17, defect 1). */
-function ChangedMark({ block }: { block: BlockInfo }) {
+/**
+ * "changed": live params the engine runs with values other than the file's (issue 17, defect 1).
+ * Memoised: it renders when its block's params change, not with the node's telemetry.
+ */
+const ChangedMark = memo(function ChangedMark({ block }: { block: BlockInfo }) {
   const live = useLiveBlock(block);
   const changed = changedParams(live);
   if (changed.length === 0) return null;
@@ -217,6 +220,6 @@ function ChangedMark({ block }: { block: BlockInfo }) {
       changed
     </span>
   );
-}
+});
 
 export const BlockNode = memo(BlockNodeComponent);
