@@ -4,10 +4,12 @@
  * `mosaic new-block --rust tkeo`, the cargo build, the guide's pipeline. The page shows the Rust
  * block's node running and lists its type in the editor's palette with its summary; rebuilding
  * the kernel reloads it (the Log says `reloaded tkeo.wasm: pipeline restarted`); a rebuild of
- * another ABI version leaves the running version running and the Log says why.
+ * another ABI version leaves the running version running and the Log says why. In the browser
+ * build, the block bundled into one block.js with the guide's esbuild command runs in the page's
+ * engine and is in the palette.
  */
 import { spawnSync, type ChildProcess } from "node:child_process";
-import { readFileSync, writeFileSync } from "node:fs";
+import { mkdirSync, readFileSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
 import { afterAll, beforeAll, describe, expect, test } from "vitest";
 import { requireBuild, runCli, startCli, tempDir } from "../integration/helpers";
@@ -18,7 +20,9 @@ import {
   launchChromium,
   openApp,
   ROOT,
+  serveApp,
   type Chromium,
+  type Served,
 } from "./harness";
 
 /** The pipeline of the guide's Rust section (the YAML block that names tkeo/block.ts). */
@@ -29,6 +33,20 @@ function guidePipeline(): string {
     .find((text) => text.includes("tkeo/block.ts"));
   if (yaml === undefined) throw new Error("docs/writing-blocks.md has no pipeline for tkeo");
   return yaml;
+}
+
+/** The guide's esbuild command for the browser build, run with MOSAIC's own esbuild. */
+function bundleForBrowser(crate: string): void {
+  const md = readFileSync(join(ROOT, "docs/writing-blocks.md"), "utf8");
+  const line = md.split("\n").find((l) => l.startsWith("npx esbuild block.ts"));
+  if (line === undefined) throw new Error("docs/writing-blocks.md has no esbuild command");
+  const args = line.split(/\s+/).slice(2);
+  const r = spawnSync(join(ROOT, "node_modules/.bin/esbuild"), args, {
+    cwd: crate,
+    encoding: "utf8",
+    timeout: 60_000,
+  });
+  if (r.status !== 0) throw new Error(`esbuild failed:\n${r.stderr}`);
 }
 
 function cargoBuild(crate: string): void {
@@ -133,4 +151,43 @@ describe.skipIf(!haveChromium)("a Rust block in mosaic serve's UI (Chromium)", (
     expect(errors).toEqual([]);
     await close();
   }, 300_000);
+});
+
+describe.skipIf(!haveChromium)("a Rust block in the browser build (Chromium)", () => {
+  let served: Served;
+  let browser: Chromium;
+
+  beforeAll(async () => {
+    served = await serveApp();
+    const dir = join(served.root, "e2e", "rust");
+    mkdirSync(dir);
+    const made = runCli(["new-block", "--rust", "tkeo", dir]);
+    if (made.code !== 0) throw new Error(`new-block failed: ${made.stderr}`);
+    cargoBuild(join(dir, "tkeo"));
+    bundleForBrowser(join(dir, "tkeo"));
+    writeFileSync(
+      join(dir, "pipeline.yaml"),
+      guidePipeline().replace("tkeo/block.ts", "tkeo/block.js"),
+    );
+    browser = await launchChromium();
+  }, 300_000);
+
+  afterAll(async () => {
+    await browser?.close();
+    await served?.close();
+  });
+
+  test("its bundled block.js runs in the page's engine and is in the palette", async () => {
+    const { page, errors, close } = await openApp(browser, served.url, "e2e/rust/pipeline.yaml");
+    await page.waitForSelector('[data-block="Energy"][data-status="ontime"]', { timeout: 20_000 });
+    expect(await page.textContent("header")).toMatch(/in this page/);
+    expect(await page.textContent('[data-block="Energy"]')).toContain("Tkeo");
+    await page.click('button:has-text("Edit")');
+    const item = page.locator('.palette__item[data-block-type="Tkeo"]');
+    await item.waitFor({ timeout: 15_000 });
+    expect(await item.textContent()).toContain("Teager–Kaiser energy of every channel");
+    await page.screenshot({ path: artifact("rust-block-browser.png") });
+    expect(errors).toEqual([]);
+    await close();
+  }, 120_000);
 });
