@@ -9,22 +9,13 @@ import type { DataMessage } from "../../engine/protocol";
 import { useBlockData } from "../client/hooks";
 import { onFrame } from "./frame";
 import { TrainingWindow, type TrainingSummary } from "./training-metrics";
+import type { Traces } from "./training-plot";
 
 /** Labelled samples the figures describe (a minute at 25 Hz). */
 export const WINDOW_SAMPLES = 1500;
 /** Events kept for the overlay. */
 export const TRACE_EVENTS = 300;
 const REFRESH_MS = 250;
-
-/** The overlay's recent events: times, predictions and targets (m each, row-major). */
-export interface Traces {
-  m: number;
-  t: Float64Array;
-  pred: Float64Array;
-  target: Float64Array;
-  /** Events held (the newest last). */
-  n: number;
-}
 
 export interface TrainingFeed {
   summary: TrainingSummary;
@@ -59,8 +50,9 @@ function pushTrace(tr: Traces, t: number, v: Float64Array, at: number): void {
 }
 
 export function useTrainingFeed(block: string, m: number, active: boolean): TrainingFeed {
-  const win = useRef(new TrainingWindow(m, WINDOW_SAMPLES));
-  const traces = useRef(emptyTraces(m));
+  // Made once (useState's initialiser), not on every render.
+  const [win] = useState(() => ({ current: new TrainingWindow(m, WINDOW_SAMPLES) }));
+  const [traces] = useState(() => ({ current: emptyTraces(m) }));
   const dirty = useRef(false);
   const [summary, setSummary] = useState<TrainingSummary>(() => win.current.summary());
   const [, setTick] = useState(0);
