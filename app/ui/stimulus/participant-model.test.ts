@@ -95,6 +95,13 @@ describe("participant screen model", () => {
     // Data that stopped coming (the protocol was stopped) is not shown as a cue.
     expect(participantModel(input({ phase: "hold", cue: 1 }, { fresh: false }))).toMatchObject({
       screen: "waiting",
+      instruction: "Please wait",
+    });
+    // …unless the block's status says the protocol runs (data late on a busy machine).
+    const late = input({ phase: "hold", cue: 1, text: "hold: fist (1 of 9), 0.5 s left" });
+    expect(participantModel({ ...late, fresh: false })).toMatchObject({
+      screen: "cue",
+      gesture: "fist",
     });
   });
 

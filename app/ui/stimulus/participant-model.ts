@@ -102,6 +102,8 @@ function tasksPerRepetition(params: Record<string, unknown>): number {
 }
 
 const leftText = /([\d.]+) s left/;
+/** The Stimulus's status text while its protocol runs ("hold: fist (2 of 9), 1.0 s left"). */
+const RUNNING_TEXT = /^(rest|rise|hold|capture|fall): /;
 const restText = /^rest: (.+) \((\d+) of (\d+)\)/;
 
 /** Seconds left and progress of a step of `duration` s that began at `start` (NaN: unknown). */
@@ -215,8 +217,15 @@ export function participantModel(input: ModelInput): ParticipantModel {
       instruction: input.engine === "stopped" ? "Paused" : "Please wait",
     };
   }
-  if (!input.fresh || s.phase === undefined) {
-    return { ...BLANK, screen: "waiting", instruction: "The session starts soon" };
+  // Data that stopped coming means the protocol stopped, unless the block says it runs (a
+  // moment without data on a busy machine).
+  const runs = input.fresh || RUNNING_TEXT.test(s.text);
+  if (!runs || s.phase === undefined) {
+    return {
+      ...BLANK,
+      screen: "waiting",
+      instruction: s.phase === undefined ? "The session starts soon" : "Please wait",
+    };
   }
   return trainingModel(input, s.phase);
 }
