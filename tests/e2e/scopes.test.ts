@@ -561,4 +561,40 @@ describe.skipIf(!haveChromium)("scopes and panel views (browser build, Chromium)
       await app.close();
     }
   }, 180_000);
+
+  test("a panel pops out into its own window, draws there, and comes back when it closes", async () => {
+    const app = await open(chromium, served.url);
+    const { page } = app;
+    try {
+      await openEmgScope(page);
+      const [popup] = await Promise.all([
+        page.context().waitForEvent("page"),
+        page.click('[data-panel="Emg"] .panel-frame__popout'),
+      ]);
+      await popup.waitForSelector('[data-popout="Emg"] [data-view="scope"] .mp-plot canvas');
+      // It receives data and draws in its window; the page keeps a note in its place.
+      await popup.waitForSelector('[data-popout="Emg"] .mp-foot:has-text("events/s")', {
+        timeout: 60_000,
+      });
+      expect(await page.textContent('[data-panel="Emg"] .panel-frame__body')).toContain(
+        "Shown in its own window",
+      );
+      const plot = popup.locator('[data-popout="Emg"] .mp-plot');
+      const a = await plot.screenshot();
+      await frames(page, 10);
+      expect((await plot.screenshot()).equals(a)).toBe(false);
+      // Its legend names the channels there too.
+      expect(await popup.locator(".mp-legend .mp-chip").allTextContents()).toEqual(EMG);
+      await popup.screenshot({ path: artifact("panel-popped-out.png") });
+      // Closing the window brings the panel back into the page.
+      await popup.close();
+      await page.waitForSelector(`${SCOPE} .mp-plot canvas`);
+      expect(await page.textContent('[data-panel="Emg"] .panel-frame__body')).not.toContain(
+        "Shown in its own window",
+      );
+      expect(app.errors.join("\n")).toBe("");
+    } finally {
+      await app.close();
+    }
+  }, 180_000);
 });

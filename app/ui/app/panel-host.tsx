@@ -10,6 +10,7 @@ import type { SetResult } from "../forms/params-form";
 import { BlockPanel } from "../panels/block-panel";
 import { useAvoidNode } from "./use-avoid-node";
 import type { PanelView } from "./panel-layouts";
+import { PopOut, PopOutButton } from "./pop-out";
 import { StatusDot } from "./status-dot";
 import { usePanelSize } from "./use-panel-size";
 import { useUi } from "./ui-context";
@@ -129,7 +130,9 @@ function PanelFrame({
   const ui = useUi();
   const ref = useRef<HTMLElement>(null);
   const onScreen = useOnScreen(ref);
-  const visible = !panel.collapsed && onScreen && pageVisible;
+  // Popped out into its own window, it is shown whatever this page's layout does.
+  const [popped, setPopped] = useState(false);
+  const visible = popped || (!panel.collapsed && onScreen && pageVisible);
   const drag = useRef<{ dx: number; dy: number } | null>(null);
   usePanelSize(ref, panel.floating, panel, onUpdate);
   useAvoidNode(ref, block.name, panel.floating, onUpdate);
@@ -217,6 +220,7 @@ function PanelFrame({
         <h2 id={titleId} className="panel-frame__title">
           {block.name} <span className="panel-frame__type">{block.type}</span>
         </h2>
+        <PopOutButton name={block.name} popped={popped} onToggle={() => setPopped(!popped)} />
         <button
           type="button"
           className="panel-frame__float"
@@ -239,22 +243,29 @@ function PanelFrame({
         </button>
       </header>
       <div id={`panel-body-${block.name}`} className="panel-frame__body" hidden={panel.collapsed}>
-        <BlockPanel
-          block={block}
-          visible={visible}
-          onClose={onClose}
-          {...(panel.view ? { view: panel.view } : {})}
-          onView={(view) => onUpdate({ view })}
-          {...(block.type === "Stimulus"
-            ? { onOpenStimulus: () => ui.openStimulus(block.name) }
-            : {})}
-          {...(onEditStatic
-            ? {
-                onEditStatic: (param: string, value: unknown) =>
-                  onEditStatic(block.name, param, value),
-              }
-            : {})}
-        />
+        <PopOut
+          name={block.name}
+          title={`${block.name} · MOSAIC`}
+          popped={popped}
+          onClosed={() => setPopped(false)}
+        >
+          <BlockPanel
+            block={block}
+            visible={visible}
+            onClose={onClose}
+            {...(panel.view ? { view: panel.view } : {})}
+            onView={(view) => onUpdate({ view })}
+            {...(block.type === "Stimulus"
+              ? { onOpenStimulus: () => ui.openStimulus(block.name) }
+              : {})}
+            {...(onEditStatic
+              ? {
+                  onEditStatic: (param: string, value: unknown) =>
+                    onEditStatic(block.name, param, value),
+                }
+              : {})}
+          />
+        </PopOut>
       </div>
     </section>
   );

@@ -10,6 +10,19 @@ import { formatTick } from "./channels";
 import { countDraw, onFrame, viewStats } from "./frame";
 import { blitTraces, drawTraces, holdRight, nextXRange, type ScopeLive } from "./scope-draw";
 
+/**
+ * uPlot's target as a function: uPlot tests `el instanceof HTMLElement`, which is false for an
+ * element of another window (a panel popped out into its own window).
+ */
+type Mount = Exclude<ConstructorParameters<typeof uPlot>[2], HTMLElement | undefined>;
+
+export function mountIn(el: HTMLElement): Mount {
+  return (u, init) => {
+    el.appendChild(u.root);
+    (init as () => void)();
+  };
+}
+
 /** The plot's height when nobody resized it: taller when channels are stacked. */
 export function defaultPlotHeight(stacked: boolean, channels: number): number {
   return stacked ? Math.max(220, Math.min(640, 40 * channels)) : 220;
@@ -63,7 +76,7 @@ function createPlot(el: HTMLElement, l: ScopeLive): uPlot {
     [0, 1],
     [null, null],
   ];
-  return new uPlot(opts, data, el);
+  return new uPlot(opts, data, mountIn(el));
 }
 
 /** Creates the plot in `host` for as long as `key` (channels, layout, output) stays the same. */

@@ -8,6 +8,7 @@ import { useEffect, useRef, useState, type ReactNode, type RefObject } from "rea
 import uPlot from "uplot";
 import { channelColor, formatTick } from "./channels";
 import { onFrame } from "./frame";
+import { mountIn } from "./scope-plot";
 import type { ScopeLive } from "./scope-draw";
 import { indexRange } from "./scope-view";
 import { medianFrequency, sampleRate, welch } from "./spectrum";
@@ -93,7 +94,7 @@ function spectrumPlot(el: HTMLElement, channels: number[], mdf: RefObject<number
       ],
     },
   };
-  return new uPlot(opts, [[0, 1], ...channels.map(() => [null, null])], el);
+  return new uPlot(opts, [[0, 1], ...channels.map(() => [null, null])], mountIn(el));
 }
 
 export function ScopeSpectrum({
