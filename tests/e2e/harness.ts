@@ -124,6 +124,20 @@ export interface AppPage {
   close(): Promise<void>;
 }
 
+/**
+ * Run first in every page openApp opens: the page starts without saved panel layouts (kept in
+ * localStorage, which all pages of one Chromium share: a test would find the panels an earlier
+ * test left open); a reload of the same page keeps them (sessionStorage marks it as started).
+ */
+const FRESH_PANEL_LAYOUTS = `(() => {
+  try {
+    if (sessionStorage.getItem("mosaic-e2e-page")) return;
+    sessionStorage.setItem("mosaic-e2e-page", "1");
+    for (const k of Object.keys(localStorage))
+      if (k.startsWith("mosaic.panels.")) localStorage.removeItem(k);
+  } catch {}
+})();`;
+
 /** Opens the app on `pipeline` (default: the demo) in a new tab and waits until it runs. */
 export async function openApp(
   browser: Chromium,
@@ -137,6 +151,7 @@ export async function openApp(
   } = {},
 ): Promise<AppPage> {
   const page = await browser.context.newPage();
+  await page.addInitScript(FRESH_PANEL_LAYOUTS);
   if (opts.initScript !== undefined) await page.addInitScript(opts.initScript);
   await page.emulateMedia({ reducedMotion: opts.reducedMotion ? "reduce" : "no-preference" });
   const errors: string[] = [];
