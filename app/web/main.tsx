@@ -57,7 +57,9 @@ function lendEngine(): string | undefined {
   if (engine.kind !== "page" || typeof BroadcastChannel === "undefined") return undefined;
   const id = sessionStorage.getItem(RELAY_KEY) ?? `r${Math.random().toString(36).slice(2)}`;
   sessionStorage.setItem(RELAY_KEY, id);
-  startParticipantRelay(client, openChannel(id));
+  const stop = startParticipantRelay(client, openChannel(id));
+  // Its participant windows say so when this page closes (and pick up again if it reloads).
+  window.addEventListener("pagehide", stop);
   return id;
 }
 const RELAY_KEY = "mosaic-participant-relay";
@@ -74,6 +76,7 @@ if (participant) {
     <ParticipantApp
       client={client}
       block={participant.block}
+      {...(relayed ? { link: relayed } : {})}
       {...(problem !== undefined ? { problem } : {})}
     />,
   );

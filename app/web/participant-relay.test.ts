@@ -148,4 +148,26 @@ describe("participant relay (browser build)", () => {
     participant.close();
     await until(() => e.requests.some((m) => m.type === "unwatch"), "the watch given back");
   });
+
+  test("the participant window hears the clinician's page close, and follows it when it is back", async () => {
+    const e = engine();
+    const clinician = new EngineClient(e.connection);
+    await until(() => clinician.connected, "hello");
+    await clinician.load("p.yaml", PIPELINE);
+    const link = relayConnection(openChannel("relay-d"));
+    const participant = new EngineClient(link);
+    closers.push(() => participant.close());
+    const said: boolean[] = [];
+    link.onLink((up) => said.push(up));
+    const stop = startParticipantRelay(clinician, openChannel("relay-d"));
+    await until(() => participant.connected, "hello");
+    stop(); // the clinician's page closes (or reloads)
+    await until(() => said.at(-1) === false, "the relay going down");
+    // A new page lends the engine again: the participant greets it and gets the graph.
+    const graphs = () => participant.graph;
+    participant.graph = undefined;
+    closers.push(startParticipantRelay(clinician, openChannel("relay-d")));
+    await until(() => said.at(-1) === true && graphs() !== undefined, "the relay back up");
+    expect(said).toEqual([true, false, true]);
+  });
 });

@@ -33,8 +33,11 @@ export function openChannel(id: string): ChannelLike {
 
 /** Participant → clinician: a protocol message, or goodbye (the window closes). */
 type ToRelay = { from: string; msg: UiMessage } | { from: string; bye: true };
-/** Clinician → participants: an engine message for one (`to`) or all ("*"), or "relay up". */
-type FromRelay = { to: string; msg: EngineMessage } | { relayUp: true };
+/**
+ * Clinician → participants: an engine message for one (`to`) or all ("*"), or the relay coming
+ * up (the clinician's page (re)loaded) or going down (it is closing or reloading).
+ */
+type FromRelay = { to: string; msg: EngineMessage } | { relayUp: true } | { relayDown: true };
 
 const isRecord = (v: unknown): v is Record<string, unknown> =>
   v !== null && typeof v === "object" && !Array.isArray(v);
@@ -118,8 +121,15 @@ export function startParticipantRelay(client: EngineClient, channel: ChannelLike
   return () => {
     for (const off of offs) off();
     for (const from of [...participants.keys()]) drop(from);
+    channel.postMessage({ relayDown: true } satisfies FromRelay);
     channel.close();
   };
+}
+
+/** The participant side's connection, which also says when the clinician's page comes and goes. */
+export interface RelayConnection extends EngineConnection {
+  /** `up` false: the clinician's page closed (or is reloading); true: it is back. */
+  onLink(listener: (up: boolean) => void): () => void;
 }
 
 /**
@@ -129,8 +139,9 @@ export function startParticipantRelay(client: EngineClient, channel: ChannelLike
 export function relayConnection(
   channel: ChannelLike,
   me = `p${Math.random().toString(36).slice(2)}`,
-): EngineConnection {
+): RelayConnection {
   const handlers = new Set<(m: EngineMessage) => void>();
+  const links = new Set<(up: boolean) => void>();
   let hello: UiMessage | undefined;
   const watches = new Map<string, UiMessage>();
   const send = (msg: UiMessage): void => channel.postMessage({ from: me, msg } satisfies ToRelay);
@@ -140,6 +151,11 @@ export function relayConnection(
     if (d.relayUp === true) {
       if (hello) send(hello);
       for (const w of watches.values()) send(w);
+      for (const l of links) l(true);
+      return;
+    }
+    if (d.relayDown === true) {
+      for (const l of links) l(false);
       return;
     }
     if ((d.to === me || d.to === "*") && isRecord(d.msg)) {
@@ -158,6 +174,10 @@ export function relayConnection(
     onMessage(handler) {
       handlers.add(handler);
       return () => handlers.delete(handler);
+    },
+    onLink(listener) {
+      links.add(listener);
+      return () => links.delete(listener);
     },
     close() {
       if (closed) return;

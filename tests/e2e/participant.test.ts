@@ -264,8 +264,12 @@ describe.skipIf(!haveChromium)("participant window", () => {
       expect(participant.url()).toContain("relay=");
       await expectInStep(app.page, participant);
       expect(app.errors).toEqual([]);
-      await participant.close();
+      // The clinician's page closes: the participant window says so.
       await app.close();
+      await participant.waitForSelector("text=The clinician's MOSAIC window was closed", {
+        timeout: 30_000,
+      });
+      await participant.close();
     }, 180_000);
   });
 });

@@ -4,7 +4,7 @@
  * socket, the desktop app's IPC or, in the browser build, the clinician page's relay). It never
  * loads or starts anything. Double-click (or F11) makes it full screen.
  */
-import { useCallback, useEffect, useRef, useSyncExternalStore } from "react";
+import { useCallback, useEffect, useRef, useState, useSyncExternalStore } from "react";
 import type { BlockInfo, GraphInfo } from "../../engine/protocol";
 import type { EngineClient } from "../client/engine-client";
 import { EngineContext, useEngine } from "../client/hooks";
@@ -65,8 +65,29 @@ function useGeneration(graph: GraphInfo | undefined): number {
   return seen.current.n;
 }
 
-function ParticipantRoot({ name, problem }: { name: string | undefined; problem?: string }) {
+/** Where the engine is lent by another page (the browser build): whether that page is there. */
+export interface EngineLink {
+  onLink(listener: (up: boolean) => void): () => void;
+}
+
+/** False once the lending page said it closed; true again when it comes back. */
+function useLinkUp(link: EngineLink | undefined): boolean {
+  const [up, setUp] = useState(true);
+  useEffect(() => link?.onLink(setUp), [link]);
+  return up;
+}
+
+function ParticipantRoot({
+  name,
+  problem,
+  link,
+}: {
+  name: string | undefined;
+  problem?: string;
+  link?: EngineLink;
+}) {
   const { connected, graph } = useClientView();
+  const up = useLinkUp(link);
   const block = participantBlock(graph, name);
   const generation = useGeneration(graph);
   useEffect(() => {
@@ -76,6 +97,14 @@ function ParticipantRoot({ name, problem }: { name: string | undefined; problem?
     return () => window.removeEventListener("dblclick", toggleFullscreen);
   }, []);
   if (problem !== undefined) return <Message text="Not connected" detail={problem} />;
+  if (!up) {
+    return (
+      <Message
+        text="Please wait"
+        detail="The clinician's MOSAIC window was closed; this one follows it again when it reopens."
+      />
+    );
+  }
   if (!connected) {
     return (
       <Message
@@ -98,16 +127,23 @@ export function ParticipantApp({
   client,
   block,
   problem,
+  link,
 }: {
   client: EngineClient;
   /** The Stimulus block's name (the pipeline's first Stimulus when undefined). */
   block: string | undefined;
   /** Why this page has no engine to follow (said on the screen). */
   problem?: string;
+  /** The browser build's relay: says when the clinician's page closes. */
+  link?: EngineLink;
 }) {
   return (
     <EngineContext.Provider value={client}>
-      <ParticipantRoot name={block} {...(problem !== undefined ? { problem } : {})} />
+      <ParticipantRoot
+        name={block}
+        {...(problem !== undefined ? { problem } : {})}
+        {...(link !== undefined ? { link } : {})}
+      />
     </EngineContext.Provider>
   );
 }
