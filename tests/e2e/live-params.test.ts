@@ -18,6 +18,7 @@ import {
   launchChromium,
   openApp,
   ROOT,
+  serveApp,
   type AppPage,
   type Chromium,
 } from "./harness";
@@ -222,5 +223,28 @@ describe.skipIf(!haveChromium)("live params on mosaic serve (two tabs)", () => {
     await expectShown(page, 100, true);
     await expectShown(b.page, 100, true);
     expect([...a.errors, ...b.errors]).toEqual([]);
+  }, 180_000);
+});
+
+describe.skipIf(!haveChromium)("live params in the browser build (the engine in the page)", () => {
+  test("a changed value is marked, written back with the comments kept, and unmarked", async () => {
+    const served = await serveApp();
+    const browser = await launchChromium();
+    try {
+      const app = await openApp(browser, served.url, undefined, { waitRunning: false });
+      await running(app.page);
+      await openParams(app.page);
+      await setValue(app.page, 100);
+      await expectShown(app.page, 100, true);
+      const text = await downloadText(app.page, () => app.page.click(".graph-actions__write-live"));
+      expect(text).toBe(
+        DEMO.replace("Operation: multiply, Value: 5 }", "Operation: multiply, Value: 100 }"),
+      );
+      await expectShown(app.page, 100, false);
+      expect(app.errors).toEqual([]);
+    } finally {
+      await browser.close();
+      await served.close();
+    }
   }, 180_000);
 });
