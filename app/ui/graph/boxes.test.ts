@@ -35,10 +35,10 @@ describe("box edits", () => {
     groups: [{ title: "A", x: 0, y: 0, width: 10, height: 10 }],
     comments: [{ text: "c", x: 1, y: 2, width: 30, height: 40 }],
   };
-  test("a new box is centred where asked, in whole pixels", () => {
-    expect(newBox("comment", { x: 100.4, y: 50 })).toEqual({
-      x: -20,
-      y: -5,
+  test("a new box starts where asked, in whole pixels, at its kind's size", () => {
+    expect(newBox("comment", { x: 100.4, y: -50.6 })).toEqual({
+      x: 100,
+      y: -51,
       width: 240,
       height: 110,
     });

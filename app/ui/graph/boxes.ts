@@ -44,14 +44,9 @@ export function nodesInside(box: LayoutBox, nodes: readonly NodeRect[]): string[
     .map((n) => n.id);
 }
 
-/** A box of `kind` centred on `at` (canvas coordinates). */
+/** A box of `kind` whose top-left corner is `at` (canvas coordinates, whole pixels). */
 export function newBox(kind: BoxKind, at: { x: number; y: number }): LayoutBox {
-  const size = NEW_BOX[kind];
-  return {
-    x: Math.round(at.x - size.width / 2),
-    y: Math.round(at.y - size.height / 2),
-    ...size,
-  };
+  return { x: Math.round(at.x), y: Math.round(at.y), ...NEW_BOX[kind] };
 }
 
 /** Replaces item `i` of `kind` by `f(item)`. */

@@ -34,12 +34,15 @@ function Minimap({ duration }: { duration: number }) {
 function AddBoxes({ layer }: { layer: BoxLayerProps }) {
   const flow = useReactFlow();
   const add = (kind: BoxKind, e: React.MouseEvent<HTMLButtonElement>): void => {
+    // At the top left of the view, under these buttons (where a fitted pipeline leaves room),
+    // each new one a little lower and to the right of the one before.
     const graph = e.currentTarget.closest(".block-table")?.getBoundingClientRect();
+    const { boxes } = layer;
+    const step = 24 * ((boxes.groups.length + boxes.comments.length) % 6);
     const at = graph
-      ? flow.screenToFlowPosition({ x: graph.x + graph.width / 2, y: graph.y + graph.height / 2 })
+      ? flow.screenToFlowPosition({ x: graph.x + 24 + step, y: graph.y + 80 + step })
       : { x: 0, y: 0 };
     const box = newBox(kind, at);
-    const { boxes } = layer;
     layer.onBoxes(
       kind === "group"
         ? {
