@@ -281,6 +281,7 @@ export const Stimulus = defineBlock({
     const phaseOut = ctx.output(vectorShape(1), "phase");
     const trigger = ctx.output(vectorShape(T), "trigger", columns && { labels: columns });
     const cueOut = ctx.output(vectorShape(1), "cue");
+    const progressOut = ctx.output(vectorShape(3), "progress", { labels: ["cue", "cues", "next"] });
 
     // `-Timer` (MOSAIC's form): subscribed only while the protocol runs.
     const onDemand = !timer.subscribed;
@@ -290,7 +291,6 @@ export const Stimulus = defineBlock({
     let cue = 0;
     let phase = REST;
     let phaseStart = 0;
-    const progressOut = ctx.output(vectorShape(3), "progress", { labels: ["cue", "cues", "next"] });
     let phaseEnd = 0;
     let capturing = false;
     let lastT = 0;
@@ -406,15 +406,6 @@ export const Stimulus = defineBlock({
       describe(ctx.now());
     };
 
-    const processTicks = (f: Frame): void => {
-      const n = f.n;
-      let o: Frame | null = null;
-      let ph: Frame | null = null;
-      let cu: Frame | null = null;
-      let k = 0;
-      for (let e = 0; e < n; e++) {
-        if (state !== "armed" && state !== "running") break;
-        const t = f.t[e]!;
     /** The `progress` values at `off`: cue number, cue count, label of the next cue to start. */
     const writeProgress = (v: Float64Array, off: number): void => {
       v[off] = Math.min(cue + 1, N);
@@ -423,12 +414,21 @@ export const Stimulus = defineBlock({
       v[off + 2] = phase !== END && next < N ? order[next]! : NaN;
     };
 
+    const processTicks = (f: Frame): void => {
+      const n = f.n;
+      let o: Frame | null = null;
+      let ph: Frame | null = null;
+      let cu: Frame | null = null;
+      let pr: Frame | null = null;
+      let k = 0;
+      for (let e = 0; e < n; e++) {
+        if (state !== "armed" && state !== "running") break;
+        const t = f.t[e]!;
         lastT = t;
         if (state === "armed") {
           state = "running";
           cue = 0;
           phase = REST;
-      let pr: Frame | null = null;
           phaseStart = t;
           phaseEnd = t + dur[REST]!;
           capturing = false;
@@ -443,23 +443,23 @@ export const Stimulus = defineBlock({
           o = target.frame(n - e);
           ph = phaseOut.frame(n - e);
           cu = cueOut.frame(n - e);
+          pr = progressOut.frame(n - e);
         }
         o.t[k] = t;
         ph!.t[k] = t;
         cu!.t[k] = t;
+        pr!.t[k] = t;
         ph!.v[k] = phase;
+        writeProgress(pr!.v, k * 3);
         const off = k * T;
         if (phase === REST || phase === END) {
           o.v.fill(0, off, off + T);
           cu!.v[k] = NaN;
-          pr = progressOut.frame(n - e);
         } else {
           const label = order[cue]!;
           const tg = targets[label]!;
           let gain = 1;
-        pr!.t[k] = t;
           if (phase === RISE || phase === FALL) {
-        writeProgress(pr!.v, k * 3);
             const x = (Math.PI / 2) * ((t - phaseStart) / dur[phase]!);
             const s = phase === RISE ? Math.sin(x) : Math.cos(x);
             gain = s * s;
@@ -480,20 +480,20 @@ export const Stimulus = defineBlock({
         o.n = k;
         ph!.n = k;
         cu!.n = k;
+        pr!.n = k;
         target.emit(o);
         phaseOut.emit(ph!);
         cueOut.emit(cu!);
+        progressOut.emit(pr!);
       }
     };
 
     describe(0);
 
     return {
-        pr!.n = k;
       start() {
         started = true;
         if (p.Autostart) begin();
-        progressOut.emit(pr!);
         else subscribe(false);
       },
       stop() {
