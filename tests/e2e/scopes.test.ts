@@ -597,4 +597,39 @@ describe.skipIf(!haveChromium)("scopes and panel views (browser build, Chromium)
       await app.close();
     }
   }, 180_000);
+
+  test("the docked panels' edge drags wider and the scope widens with it", async () => {
+    const app = await open(chromium, served.url);
+    const { page } = app;
+    try {
+      await openEmgScope(page);
+      const width = (sel: string) =>
+        page.$eval(sel, (e) => (e as unknown as { offsetWidth: number }).offsetWidth);
+      const dock0 = await width("aside.dock");
+      const plot0 = await width(`${SCOPE} .mp-plot canvas`);
+      const edge = (await page.locator(".dock-resizer").boundingBox())!;
+      await page.mouse.move(edge.x + edge.width / 2, edge.y + 200);
+      await page.mouse.down();
+      await page.mouse.move(edge.x + edge.width / 2 - 300, edge.y + 200, { steps: 6 });
+      await page.mouse.up();
+      expect(Math.abs((await width("aside.dock")) - (dock0 + 300))).toBeLessThanOrEqual(2);
+      // The scope's plot follows its panel's width.
+      await page.waitForFunction(
+        ([sel, w]) =>
+          ((
+            globalThis as unknown as { document: { querySelector(q: string): { width: number } } }
+          ).document.querySelector(sel).width ?? 0) >
+          (w as number) + 200,
+        [`${SCOPE} .mp-plot canvas`, plot0] as const,
+      );
+      // Arrow keys on the focused edge: 40 px a press.
+      await page.focus(".dock-resizer");
+      await page.keyboard.press("ArrowLeft");
+      expect(Math.abs((await width("aside.dock")) - (dock0 + 340))).toBeLessThanOrEqual(2);
+      await page.screenshot({ path: artifact("dock-wide.png") });
+      expect(app.errors.join("\n")).toBe("");
+    } finally {
+      await app.close();
+    }
+  }, 180_000);
 });

@@ -10,6 +10,7 @@ import type { SetResult } from "../forms/params-form";
 import { BlockPanel } from "../panels/block-panel";
 import { useAvoidNode } from "./use-avoid-node";
 import type { PanelView } from "./panel-layouts";
+import { DockResizer, useDockWidth } from "./dock-resizer";
 import { PopOut, PopOutButton } from "./pop-out";
 import { StatusDot } from "./status-dot";
 import { usePanelSize } from "./use-panel-size";
@@ -290,6 +291,7 @@ export function PanelHost({
   children: ReactNode;
 }) {
   const pageVisible = usePageVisible();
+  const [dockWidth, setDockWidth] = useDockWidth();
   const frame = (p: OpenPanel) => {
     const block = blocks.get(p.name);
     if (!block) return null;
@@ -314,8 +316,13 @@ export function PanelHost({
         {children}
         <div className="floating-layer">{floating.map(frame)}</div>
       </div>
+      {docked.length > 0 ? <DockResizer width={dockWidth} onWidth={setDockWidth} /> : null}
       {docked.length > 0 ? (
-        <aside className="dock" aria-label="Control panels">
+        <aside
+          className="dock"
+          aria-label="Control panels"
+          style={dockWidth !== undefined ? { width: dockWidth } : undefined}
+        >
           {docked.map(frame)}
         </aside>
       ) : null}
