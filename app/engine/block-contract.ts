@@ -82,22 +82,29 @@ export function contractInputs(def: AnyBlockDefinition, s: ContractSetup): Input
   });
 }
 
-/** Runs every check on `def`; `resources` are the files it may read (the module's folder). */
+/**
+ * Runs every check on `def`; `resources` are the files it may read (the module's folder);
+ * `onResult` hears each result as soon as it is known (a later check may never end).
+ */
 export async function runBlockContract(
   def: AnyBlockDefinition,
   setup: ContractSetup,
   resources: Resources,
   base: Catalog,
+  onResult?: (r: CheckResult) => void,
 ): Promise<CheckResult[]> {
   const inputs = contractInputs(def, setup);
   const ctx: Run = { def, setup, inputs, resources, base };
   const out: CheckResult[] = [];
   for (const [name, check] of CHECKS) {
+    let r: CheckResult;
     try {
-      out.push({ name, ...(await check(ctx)) });
+      r = { name, ...(await check(ctx)) };
     } catch (e) {
-      out.push({ name, ok: false, detail: `${(e as Error).name ?? "Error"}: ${errorMessage(e)}` });
+      r = { name, ok: false, detail: `${(e as Error).name ?? "Error"}: ${errorMessage(e)}` };
     }
+    out.push(r);
+    onResult?.(r);
   }
   return out;
 }
@@ -115,7 +122,17 @@ type Check = (r: Run) => Promise<{ ok: boolean; detail: string }>;
 const pass = (detail: string) => ({ ok: true, detail });
 const fail = (detail: string) => ({ ok: false, detail });
 
-const CHECKS: [string, Check][] = [
+/** The checks' names, in the order they run. */
+export const CHECK_NAMES = [
+  "docs",
+  "defaults validate",
+  "frame splitting",
+  "reset repeats",
+  "dispose twice",
+  "garbage params",
+] as const;
+
+const CHECKS: [(typeof CHECK_NAMES)[number], Check][] = [
   ["docs", checkDocs],
   ["defaults validate", checkDefaults],
   ["frame splitting", checkSplitting],

@@ -20,8 +20,19 @@ export interface BlockReport {
 export type TestBlockOutcome =
   { ok: true; blocks: BlockReport[] } | { ok: false; problems: string[] };
 
+/** What a test run reports as it goes (a check that never ends must not hide the others). */
+export interface TestBlockProgress {
+  block?(type: string): void;
+  result?(r: CheckResult): void;
+  /** Block types not to test (tested already, by a run that was stopped). */
+  skip?: ReadonlySet<string>;
+}
+
 /** The module's blocks, each through the contract; or why the module gives none. */
-export async function testBlockFile(file: string): Promise<TestBlockOutcome> {
+export async function testBlockFile(
+  file: string,
+  progress: TestBlockProgress = {},
+): Promise<TestBlockOutcome> {
   const full = resolve(file);
   const r = await loadBlockModule(full);
   if (!r.ok) {
@@ -44,7 +55,10 @@ export async function testBlockFile(file: string): Promise<TestBlockOutcome> {
   const resources = nodeResources(dirname(full));
   const blocks: BlockReport[] = [];
   for (const def of found.defs as AnyBlockDefinition[]) {
-    const checks = await runBlockContract(def, setups[def.type] ?? {}, resources, catalog);
+    if (progress.skip?.has(def.type)) continue;
+    progress.block?.(def.type);
+    const setup = setups[def.type] ?? {};
+    const checks = await runBlockContract(def, setup, resources, catalog, progress.result);
     blocks.push({ type: def.type, checks });
   }
   return { ok: true, blocks };

@@ -234,6 +234,26 @@ describe("broken user blocks", () => {
     ]);
   }, 60_000);
 
+  test("mosaic test-block fails a block that never returns in its check and goes on", () => {
+    const r = runCli(["test-block", "blocks/broken.ts", "--timeout", "8"], {
+      cwd: dir,
+      timeoutMs: 90_000,
+    });
+    expect(r.code).toBe(1);
+    const lines = r.stdout.split("\n");
+    const at = (block: string) => lines.indexOf(`blocks/broken.ts: ${block}`);
+    expect(at("Looper")).toBeGreaterThanOrEqual(0);
+    expect(lines.slice(at("Looper") + 1, at("Looper") + 5)).toEqual([
+      "  PASS docs: summary, help and 0 described params",
+      "  PASS defaults validate: params {}; outputs []",
+      "  FAIL frame splitting: did not finish within 8 s — a block that never returns (an endless loop in process, create or a timer?)",
+      "  Looper: stopped in frame splitting",
+    ]);
+    // The module's other block is still tested, after the stuck one.
+    expect(at("Thrower")).toBeGreaterThan(at("Looper"));
+    expect(lines).toContain("  FAIL frame splitting: Error: thrower is broken on purpose");
+  }, 120_000);
+
   test("a throwing process and an endless loop on its own worker: named, and the rest runs", () => {
     writeFileSync(
       join(dir, "broken.yaml"),
