@@ -88,6 +88,9 @@ describe("a TypeScript block made from docs/writing-blocks.md", () => {
 
   test("validates, and runs headless with the output the formula gives", () => {
     expect(runCli(["validate", "pipeline.yaml"], { cwd: dir }).code).toBe(0);
+    // mosaic format knows the file (its own blocks included) and leaves it as it is.
+    const f = runCli(["format", "pipeline.yaml", "--check"], { cwd: dir });
+    expect([f.code, f.stdout.trim()]).toEqual([0, "pipeline.yaml: unchanged"]);
     const r = runCli(["run", "pipeline.yaml", "--clock", "virtual", "--duration", "2", "--json"], {
       cwd: dir,
     });
