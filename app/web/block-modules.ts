@@ -8,6 +8,10 @@
 import { errorMessage } from "../engine/diagnostics";
 import { installSdk, sdkModuleSource, type ModuleLoadResult } from "../engine/user-blocks";
 
+/** Where the browser build finds block modules (not in a folder opened from this computer). */
+const SERVED_ONLY =
+  "the browser build loads block modules from the web server, beside a pipeline served with the page";
+
 let sdkUrl: string | undefined;
 
 /** A blob: URL of the module that stands for `mosaic/sdk` (made once). */
@@ -40,7 +44,10 @@ export async function loadBrowserBlockModule(path: string): Promise<ModuleLoadRe
   let text: string;
   try {
     const r = await fetch(url);
-    if (!r.ok) return { ok: false, message: `cannot fetch it: HTTP ${r.status}`, inputs };
+    if (!r.ok) {
+      const why = `cannot fetch it from ${url.href}: HTTP ${r.status}`;
+      return { ok: false, message: `${why} (${SERVED_ONLY})`, inputs };
+    }
     text = await r.text();
   } catch (e) {
     return { ok: false, message: `cannot fetch it: ${errorMessage(e)}`, inputs };
