@@ -28,7 +28,7 @@ import { BlockMenu } from "./block-menu";
 import { BlockNode, GraphStateContext, type BlockNodeType, type GraphState } from "./block-node";
 import { initialBoxes, rememberBoxes, type Boxes } from "./boxes";
 import { LargeFlowTools } from "./large-flow-tools";
-import { layeredLayout } from "./layout";
+import { pipelinePositions } from "./layout-place";
 import { updateLayout } from "./layout-yaml";
 import { EdgeMarkerDefs, RateEdge, type RateEdgeType } from "./rate-edge";
 import { ReadableZoom } from "./readable-zoom";
@@ -61,18 +61,14 @@ export function graphPositions(
   graph: GraphInfo,
   ignoreFile = false,
 ): Map<string, { x: number; y: number }> {
-  const names = graph.blocks.map((b) => b.name);
-  const edges = graph.blocks.flatMap((b) => b.inputs.map((i) => [i.block, b.name] as const));
-  const auto = layeredLayout(names, edges);
-  const out = new Map<string, { x: number; y: number }>();
-  for (const b of graph.blocks) {
-    const a = auto.get(b.name)!;
-    out.set(
-      b.name,
-      !ignoreFile && b.layout ? { x: b.layout.x, y: b.layout.y } : { x: a.x, y: a.y },
-    );
-  }
-  return out;
+  // Blocks without a Layout key among blocks with one go to free space (issue 17, defect 8).
+  return pipelinePositions(
+    graph.blocks.map((b) => ({
+      name: b.name,
+      inputs: b.inputs.map((i) => i.block),
+      ...(!ignoreFile && b.layout ? { layout: { x: b.layout.x, y: b.layout.y } } : {}),
+    })),
+  );
 }
 
 function buildNodes(

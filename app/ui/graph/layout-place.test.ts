@@ -1,6 +1,6 @@
 import { describe, expect, test } from "vitest";
 import { DEFAULT_LAYOUT } from "./layout";
-import { freeSpot, placeBlocks, type Point } from "./layout-place";
+import { freeSpot, pipelinePositions, placeBlocks, type Point } from "./layout-place";
 
 const W = DEFAULT_LAYOUT.nodeWidth;
 const H = DEFAULT_LAYOUT.nodeHeight;
@@ -70,5 +70,31 @@ describe("placing blocks that have no position yet", () => {
     const ps = [...out.values()];
     for (let i = 0; i < ps.length; i++)
       for (let j = i + 1; j < ps.length; j++) expect(overlaps(ps[i]!, ps[j]!)).toBe(false);
+  });
+});
+
+describe("a pipeline's positions (the BlockTable's)", () => {
+  test("a block without a Layout key among blocks with one lands on none of them", () => {
+    // A and B saved side by side; C (reading A, added later in the text) has no Layout: the
+    // automatic layout alone would put it in B's layer, at B's place.
+    const blocks = [
+      { name: "A", inputs: [], layout: { x: 0, y: 0 } },
+      { name: "B", inputs: ["A"], layout: { x: W + DEFAULT_LAYOUT.gapX, y: 0 } },
+      { name: "C", inputs: ["A"] },
+    ];
+    const out = pipelinePositions(blocks);
+    expect(out.get("A")).toEqual({ x: 0, y: 0 });
+    expect(out.get("B")).toEqual({ x: W + DEFAULT_LAYOUT.gapX, y: 0 });
+    expect(overlaps(out.get("C")!, out.get("A")!)).toBe(false);
+    expect(overlaps(out.get("C")!, out.get("B")!)).toBe(false);
+  });
+
+  test("without Layout keys it is the automatic layout", () => {
+    const out = pipelinePositions([
+      { name: "A", inputs: [] },
+      { name: "B", inputs: ["A"] },
+    ]);
+    expect(out.get("B")!.x).toBeGreaterThan(out.get("A")!.x);
+    expect(overlaps(out.get("A")!, out.get("B")!)).toBe(false);
   });
 });

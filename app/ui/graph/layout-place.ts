@@ -5,7 +5,7 @@
  * from (or where the automatic layout puts it, when none of them has a position), then to the
  * nearest spot where its box, with a margin, covers no other. Pure and deterministic; no DOM.
  */
-import { DEFAULT_LAYOUT } from "./layout";
+import { DEFAULT_LAYOUT, layeredLayout } from "./layout";
 
 export interface Point {
   x: number;
@@ -101,4 +101,21 @@ export function placeBlocks(
     out.set(b.name, freeSpot(wanted, [...out.values()], size));
   }
   return out;
+}
+
+/**
+ * A pipeline's positions: its blocks' `layout` (the file's Layout keys) where they have one, the
+ * automatic layered layout when none has, else free space beside their inputs (placeBlocks).
+ */
+export function pipelinePositions(
+  blocks: readonly { name: string; inputs: readonly string[]; layout?: Point }[],
+): Map<string, Point> {
+  const names = blocks.map((b) => b.name);
+  const edges = blocks.flatMap((b) => b.inputs.map((i) => [i, b.name] as const));
+  const auto = new Map<string, Point>();
+  for (const [k, a] of layeredLayout(names, edges)) auto.set(k, { x: a.x, y: a.y });
+  return placeBlocks(
+    blocks.map((b) => ({ name: b.name, inputs: b.inputs, ...(b.layout ? { at: b.layout } : {}) })),
+    auto,
+  );
 }
