@@ -119,7 +119,13 @@ function colourRows(
 async function open(chromium: Chromium, base: string, pipeline?: string): Promise<AppPage> {
   const app = await openApp(chromium, base, pipeline, { waitRunning: false });
   app.page.setDefaultTimeout(60_000);
-  await app.page.waitForSelector('.app[data-engine-state="running"]', { timeout: 60_000 });
+  await app.page
+    .waitForSelector('.app[data-engine-state="running"]', { timeout: 60_000 })
+    .catch(async (e: unknown) => {
+      const state = await app.page.getAttribute(".app", "data-engine-state").catch(() => null);
+      await app.page.screenshot({ path: artifact("scopes-not-running.png") }).catch(() => null);
+      throw new Error(`${String(e)}; engine state ${state}; errors: ${app.errors.join("; ")}`);
+    });
   return app;
 }
 

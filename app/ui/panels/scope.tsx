@@ -14,7 +14,15 @@
  * (scope-pointer.ts). The spectrum (Welch PSD, median frequency) is of the window in view
  * (scope-spectrum.tsx); CSV and PNG export it (scope-export.ts).
  */
-import { useCallback, useEffect, useMemo, useRef, useState, type ReactNode } from "react";
+import {
+  useCallback,
+  useEffect,
+  useMemo,
+  useRef,
+  useState,
+  type ReactNode,
+  type RefObject,
+} from "react";
 import type uPlot from "uplot";
 import type { DataMessage } from "../../engine/protocol";
 import { useBlockData } from "../client/hooks";
@@ -265,38 +273,28 @@ function Legend({
   );
 }
 
-export function Scope(props: ViewProps<ScopeSettings>): ReactNode {
-  const { block, output, active, settings, onSettings, tools } = props;
-  const { rows, cols } = output.shape;
-  const channels = useMemo(
-    () => (settings.channels ?? defaultChannels(cols)).filter((c) => c < cols),
-    [settings.channels, cols],
-  );
-  const matrixMode: MatrixMode = rows > 1 ? settings.matrixMode : "newest";
-  const statsKey = `scope:${block.name}.${output.name}`;
-  const host = useRef<HTMLDivElement>(null);
+/**
+ * The pointer's part (wired once per plot, reading the latest settings through a ref): the
+ * readout, zoom and pan, and the zoom's reset.
+ */
+function useScopePointer(
+  live: { current: ScopeLive },
+  windowS: number,
+  onSettings: (p: Partial<ScopeSettings>) => void,
+) {
   const readout = useRef<HTMLDivElement>(null);
   const cursor = useRef<HTMLDivElement>(null);
   const pointer = useRef<number | null>(null);
-  const [info, setInfo] = useState({ received: 0, skipped: 0 });
   const [zoomed, setZoomed] = useState(false);
-  const counts = useRef({ received: 0, skipped: 0, lastInfo: 0 });
-  const live = useRef<ScopeLive>(newLive(settings));
-  syncLive(live.current, settings, output, channels);
-  useScopeData(props, channels, matrixMode, live, statsKey, counts);
-  usePauseHold(live, settings.paused, settings.windowS);
-  const stacked = live.current.stacked;
-
+  const latest = useRef({ windowS, onSettings });
+  latest.current = { windowS, onSettings };
   const updateReadout = useCallback(() => {
     const l = live.current;
     const px = pointer.current;
     if (!readout.current || !cursor.current || !l.plot) return;
     const lines = px === null ? null : readoutLines(l, l.plot, px);
     showReadout(readout.current, cursor.current, lines, px ?? 0, l.plot.over.offsetLeft);
-  }, []);
-  // What the pointer handlers read (they are wired once per plot, not per render).
-  const latest = useRef({ windowS: settings.windowS, onSettings });
-  latest.current = { windowS: settings.windowS, onSettings };
+  }, [live]);
   const resetZoom = useCallback(() => {
     const l = live.current;
     l.span = latest.current.windowS;
@@ -304,7 +302,7 @@ export function Scope(props: ViewProps<ScopeSettings>): ReactNode {
     l.laneGain = 1;
     l.dirty = true;
     setZoomed(false);
-  }, []);
+  }, [live]);
   const attach = useCallback(
     (u: uPlot) =>
       attachPointer(
@@ -321,13 +319,70 @@ export function Scope(props: ViewProps<ScopeSettings>): ReactNode {
           onReset: resetZoom,
         },
       ),
-    [resetZoom, updateReadout],
+    [live, resetZoom, updateReadout],
   );
+  return { readout, cursor, pointer, zoomed, updateReadout, resetZoom, attach };
+}
+
+/** The plot's box: the plot (its height drags), the cursor line and the readout over it. */
+function PlotBox({
+  host,
+  cursor,
+  readout,
+  height,
+  label,
+}: {
+  host: RefObject<HTMLDivElement | null>;
+  cursor: RefObject<HTMLDivElement | null>;
+  readout: RefObject<HTMLDivElement | null>;
+  height: number;
+  label: string;
+}): ReactNode {
+  return (
+    <div className="mp-plot-box">
+      <div
+        className="mp-plot mp-resizable"
+        ref={host}
+        style={{ height }}
+        aria-label={label}
+        role="img"
+      />
+      <div ref={cursor} className="mp-cursor" hidden aria-hidden="true" />
+      <div
+        ref={readout}
+        className="mp-readout"
+        hidden
+        role="status"
+        aria-label="Values under the cursor"
+      />
+    </div>
+  );
+}
+
+export function Scope(props: ViewProps<ScopeSettings>): ReactNode {
+  const { block, output, active, settings, onSettings, tools } = props;
+  const { rows, cols } = output.shape;
+  const channels = useMemo(
+    () => (settings.channels ?? defaultChannels(cols)).filter((c) => c < cols),
+    [settings.channels, cols],
+  );
+  const matrixMode: MatrixMode = rows > 1 ? settings.matrixMode : "newest";
+  const statsKey = `scope:${block.name}.${output.name}`;
+  const host = useRef<HTMLDivElement>(null);
+  const [info, setInfo] = useState({ received: 0, skipped: 0 });
+  const counts = useRef({ received: 0, skipped: 0, lastInfo: 0 });
+  const live = useRef<ScopeLive>(newLive(settings));
+  syncLive(live.current, settings, output, channels);
+  useScopeData(props, channels, matrixMode, live, statsKey, counts);
+  usePauseHold(live, settings.paused, settings.windowS);
+  const stacked = live.current.stacked;
+  const ptr = useScopePointer(live, settings.windowS, onSettings);
   useEffect(() => {
     live.current.colours = Uint32Array.from(channels, (c) => colourWord(channelColor(c)));
     live.current.dirty = true;
   }, [channels]);
-  usePlot(host, live, attach, [channels, output, stacked, output.unit, attach]);
+  usePlot(host, live, ptr.attach, [channels, output, stacked, output.unit, ptr.attach]);
+  const { pointer, updateReadout } = ptr;
   const afterDraw = useCallback(
     (now: number) => {
       if (pointer.current !== null) updateReadout();
@@ -340,10 +395,10 @@ export function Scope(props: ViewProps<ScopeSettings>): ReactNode {
         c.skipped = 0;
       }
     },
-    [updateReadout],
+    [pointer, updateReadout],
   );
   useDrawLoop(live, active, statsKey, afterDraw);
-
+  const l = live.current;
   return (
     <div
       className="mp-scope"
@@ -358,36 +413,26 @@ export function Scope(props: ViewProps<ScopeSettings>): ReactNode {
         output={output}
         channels={channels}
         matrixMode={matrixMode}
-        zoomed={zoomed}
-        onResetZoom={resetZoom}
-        onCsv={() => downloadCsv(live.current, block.name, output.name)}
+        zoomed={ptr.zoomed}
+        onResetZoom={ptr.resetZoom}
+        onCsv={() => downloadCsv(l, block.name, output.name)}
         onPng={() => {
-          const c = live.current.plot?.ctx.canvas;
-          if (c) downloadPng(c, live.current.names, channels, block.name, output.name);
+          const c = l.plot?.ctx.canvas;
+          if (c) downloadPng(c, l.names, channels, block.name, output.name);
         }}
-        suggestY={() => live.current.y}
+        suggestY={() => l.y}
         tools={tools}
       />
-      <div className="mp-plot-box">
-        <div
-          className="mp-plot mp-resizable"
-          ref={host}
-          style={{ height: defaultPlotHeight(stacked, channels.length) }}
-          aria-label={`Scope of ${block.name}.${output.name}`}
-          role="img"
-        />
-        <div ref={cursor} className="mp-cursor" hidden aria-hidden="true" />
-        <div
-          ref={readout}
-          className="mp-readout"
-          hidden
-          role="status"
-          aria-label="Values under the cursor"
-        />
-      </div>
+      <PlotBox
+        host={host}
+        cursor={ptr.cursor}
+        readout={ptr.readout}
+        height={defaultPlotHeight(stacked, channels.length)}
+        label={`Scope of ${block.name}.${output.name}`}
+      />
       <Legend output={output} channels={channels} onSettings={onSettings} />
       {settings.spectrum && (
-        <ScopeSpectrum live={live} channels={channels} names={live.current.names} active={active} />
+        <ScopeSpectrum live={live} channels={channels} names={l.names} active={active} />
       )}
       <Footer props={props} channels={channels} matrixMode={matrixMode} info={info} />
     </div>
