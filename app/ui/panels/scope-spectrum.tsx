@@ -46,7 +46,12 @@ export function spectrumOf(l: ScopeLive): SpectrumResult | null {
   return f ? { f, p, mdf, fs } : null;
 }
 
-function spectrumPlot(el: HTMLElement, channels: number[], mdf: RefObject<number[]>): uPlot {
+function spectrumPlot(
+  el: HTMLElement,
+  channels: number[],
+  unit: string,
+  mdf: RefObject<number[]>,
+): uPlot {
   const axis: Partial<uPlot.Axis> = {
     font: "11px system-ui, sans-serif",
     grid: { stroke: "rgba(31, 35, 40, 0.1)", width: 1 },
@@ -65,6 +70,9 @@ function spectrumPlot(el: HTMLElement, channels: number[], mdf: RefObject<number
       {
         ...axis,
         size: 56,
+        label: unit ? `${unit}²/Hz` : "per Hz",
+        labelSize: 16,
+        labelFont: "11px system-ui, sans-serif",
         // A log axis leaves some splits unlabelled (null).
         values: (_u, s) => s.map((v: number | null) => (v === null ? "" : v.toExponential(0))),
       },
@@ -101,11 +109,13 @@ export function ScopeSpectrum({
   live,
   channels,
   names,
+  unit,
   active,
 }: {
   live: RefObject<ScopeLive>;
   channels: number[];
   names: string[];
+  unit: string;
   active: boolean;
 }): ReactNode {
   const host = useRef<HTMLDivElement>(null);
@@ -116,7 +126,7 @@ export function ScopeSpectrum({
   useEffect(() => {
     const el = host.current;
     if (!el) return undefined;
-    const u = spectrumPlot(el, channels, mdf);
+    const u = spectrumPlot(el, channels, unit, mdf);
     plot.current = u;
     const ro = new ResizeObserver(() => {
       const w = Math.max(100, el.clientWidth);
@@ -128,7 +138,7 @@ export function ScopeSpectrum({
       u.destroy();
       plot.current = null;
     };
-  }, [channels]);
+  }, [channels, unit]);
 
   useEffect(() => {
     if (!active) return undefined;

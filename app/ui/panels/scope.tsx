@@ -432,7 +432,13 @@ export function Scope(props: ViewProps<ScopeSettings>): ReactNode {
       />
       <Legend output={output} channels={channels} onSettings={onSettings} />
       {settings.spectrum && (
-        <ScopeSpectrum live={live} channels={channels} names={l.names} active={active} />
+        <ScopeSpectrum
+          live={live}
+          channels={channels}
+          names={l.names}
+          unit={l.unit}
+          active={active}
+        />
       )}
       <Footer props={props} channels={channels} matrixMode={matrixMode} info={info} />
     </div>
