@@ -301,8 +301,11 @@ describe("main process (bundled, with a stand-in electron module)", () => {
 
     dialogs.save = join(dir, "copy");
     (findMenuItem(fake.menu() as never, "save-as")!.click as () => void)();
-    await until(() => existsSync(join(dir, "copy.yaml")));
-    expect(readFileSync(join(dir, "copy.yaml"), "utf8")).toBe(readFileSync(dialogs.open, "utf8"));
+    // The file exists as soon as writeFile opens it: wait for its whole text.
+    const copy = join(dir, "copy.yaml");
+    const text = readFileSync(dialogs.open, "utf8");
+    await until(() => existsSync(copy) && readFileSync(copy, "utf8") === text);
+    expect(readFileSync(copy, "utf8")).toBe(text);
     expect(fake.errors).toEqual([]);
   });
 
