@@ -275,6 +275,19 @@ describe.skipIf(!haveChromium)("large flows on the BlockTable (Chromium)", () =>
     );
     await page.keyboard.press("Control+Enter");
     await page.waitForSelector('.graph-box[data-box="comment"] .graph-box__text');
+    // Their text is never under 11 px on screen, whatever the zoom (as the graph's own).
+    const smallest = await page.evaluate(() => {
+      const w = globalThis as unknown as InPageWindow;
+      const v = w.document.querySelector(".block-table .react-flow__viewport")!;
+      const zoom = Number(/matrix\(([^,]+)/.exec(w.getComputedStyle(v).transform)![1]);
+      const sel = ".graph-box__title, .graph-box__text, .graph-box__buttons button";
+      return Math.min(
+        ...[...w.document.querySelectorAll(sel)].map(
+          (e) => parseFloat(w.getComputedStyle(e).fontSize!) * zoom,
+        ),
+      );
+    });
+    expect(smallest).toBeGreaterThanOrEqual(11);
 
     const [download] = await Promise.all([
       page.waitForEvent("download"),
