@@ -352,7 +352,7 @@ function PlotBox({
         ref={readout}
         className="mp-readout"
         hidden
-        role="status"
+        aria-live="off"
         aria-label="Values under the cursor"
       />
     </div>
