@@ -7,6 +7,9 @@ import { BlockHarness, runVirtualPipeline, type HarnessOptions } from "../../eng
 import { convertLegacy, ticks } from "../../../tests/support/blocks";
 import { fsResources, memoryResources, REPO_ROOT } from "../../../tests/support/fs-resources";
 import { FilePlayer } from "./file-player";
+import { firstRowAtOrAfter, seekSeconds } from "./file-player-seek";
+import { statusText } from "./file-player-status";
+import { sortedMedian } from "./file-player-timing";
 
 const RECORDING = "pipelines/data/emg_bursts_1000hz.csv";
 const timer = { shape: EMPTY_SHAPE, rate: 1000, isTimer: true };
@@ -372,5 +375,47 @@ describe("FilePlayer", () => {
       Loop: false,
       Speed: 1,
     });
+  });
+});
+
+describe("FilePlayer pieces", () => {
+  test("status text: position, total, pause, loop; finished; stopped", () => {
+    const s = { row: 7, loops: 0, done: false, paused: false, failed: undefined };
+    expect(statusText(s, 20)).toBe("row 7 / 20");
+    expect(statusText(s, undefined)).toBe("row 7");
+    expect(statusText({ ...s, paused: true, loops: 2 }, 20)).toBe("paused at row 7 / 20 (loop 3)");
+    expect(statusText({ ...s, done: true }, 20)).toBe("finished: 20 rows played");
+    expect(statusText({ ...s, done: true }, undefined)).toBe("finished: 7 rows played");
+    expect(statusText({ ...s, done: true, failed: "line 9: bad" }, 20)).toBe(
+      "stopped at row 7: line 9: bad",
+    );
+  });
+
+  test("seek argument: seconds as a number or a numeric string, finite and not negative", () => {
+    expect(seekSeconds(2.5)).toBe(2.5);
+    expect(seekSeconds("12")).toBe(12);
+    expect(seekSeconds(0)).toBe(0);
+    for (const bad of [-1, "soon", Infinity, NaN, undefined, null, [1]]) {
+      expect(seekSeconds(bad)).toBeUndefined();
+    }
+  });
+
+  test("the first row at or after a time (rows in time order, repeated times)", () => {
+    const t = [0, 1, 1, 1, 2.5, 4];
+    const at = (want: number) => firstRowAtOrAfter((r) => t[r]!, t.length, want);
+    expect(at(-1)).toBe(0);
+    expect(at(0)).toBe(0);
+    expect(at(0.5)).toBe(1);
+    expect(at(1)).toBe(1);
+    expect(at(2.5)).toBe(4);
+    expect(at(3)).toBe(5);
+    expect(at(4.01)).toBe(6);
+    expect(firstRowAtOrAfter(() => 0, 0, 1)).toBe(0);
+  });
+
+  test("median of sorted intervals: the middle one, or the mean of the middle two", () => {
+    expect(sortedMedian(Float64Array.of(0.5))).toBe(0.5);
+    expect(sortedMedian(Float64Array.of(0.1, 0.2, 0.9))).toBe(0.2);
+    expect(sortedMedian(Float64Array.of(0, 0.25, 0.75, 1))).toBe(0.5);
   });
 });
