@@ -2,14 +2,11 @@ import { z } from "zod";
 import {
   BlockConfigError,
   defineBlock,
-  formatShape,
-  shapeSize,
   type BlockContext,
-  type Frame,
-  type PythonCallError,
-  type PythonSidecar,
+  type BlockInstance,
   type Shape,
 } from "../../engine";
+import { PythonRun, type PythonRunSettings } from "./python-run";
 
 const params = z.strictObject({
   Module: z
@@ -122,98 +119,48 @@ function refuseInstalledModule(ctx: BlockContext, module: string): void {
 const looksLikeFile = (m: string): boolean =>
   m.endsWith(".py") || m.includes("/") || m.includes("\\");
 
-/** p50 and p99 of the first `n` values of `ring` (a copy is sorted). */
-function percentiles(ring: Float64Array, n: number, scratch: Float64Array): [number, number] {
-  if (n === 0) return [NaN, NaN];
-  const s = scratch.subarray(0, n);
-  s.set(ring.subarray(0, n));
-  s.sort();
-  const at = (q: number): number => s[Math.min(n - 1, Math.ceil(q * n) - 1)]!;
-  return [at(0.5), at(0.99)];
-}
-
-const ms = (x: number): string =>
-  !(x === x)
-    ? "–"
-    : x < 1
-      ? `${x.toFixed(2)} ms`
-      : x < 100
-        ? `${x.toFixed(1)} ms`
-        : `${Math.round(x)} ms`;
-
-/** A duration of a call still running: ms below 10 s, then s. */
-const running = (x: number): string => (x < 10_000 ? ms(x) : `${(x / 1000).toFixed(1)} s`);
-
-const TIMES = 256;
-const WARN_EVERY_MS = 5000;
 /** The hard limit's default: this many budgets, at least HARD_MIN_MS (HARD_NO_BUDGET_MS without). */
 const HARD_BUDGETS = 10;
 const HARD_MIN_MS = 2000;
 const HARD_NO_BUDGET_MS = 10_000;
 
-/** Events (timestamp + values) waiting, oldest first: a ring that grows when full. */
-class EventQueue {
-  private t: Float64Array;
-  private v: Float64Array;
-  private head = 0;
-  n = 0;
+/** The output shape the params give, if they give one. */
+const declaredShape = (p: Params): Shape | undefined =>
+  p.OutputShape ? { rows: p.OutputShape[0], cols: p.OutputShape[1] } : undefined;
 
-  constructor(
-    private readonly size: number,
-    private cap = 4,
-  ) {
-    this.t = new Float64Array(cap);
-    this.v = new Float64Array(cap * size);
-  }
+/** What the params and the input decide before the sidecar starts. */
+function settings(ctx: BlockContext, p: Params, inShape: Shape): PythonRunSettings {
+  const budgetMs = p.Budget ?? (ctx.desiredRate > 0 ? 1000 / ctx.desiredRate : Infinity);
+  const hardLimitMs =
+    p.HardLimit ??
+    (budgetMs < Infinity ? Math.max(HARD_BUDGETS * budgetMs, HARD_MIN_MS) : HARD_NO_BUDGET_MS);
+  return {
+    module: looksLikeFile(p.Module) ? ctx.resources.resolve(p.Module) : p.Module,
+    function: p.Function,
+    ...(p.Init !== undefined ? { init: p.Init } : {}),
+    params: p.Params,
+    onError: p.OnError,
+    maxInFlight: p.MaxInFlight,
+    memoryLimitMb: p.MemoryLimit,
+    inShape,
+    declared: declaredShape(p),
+    budgetMs,
+    hardLimitMs,
+    paramOf: (kind) => paramOf(kind, p),
+  };
+}
 
-  push(values: Float64Array, t: number): void {
-    if (this.n === this.cap) this.grow();
-    this.put((this.head + this.n) % this.cap, values, t);
-    this.n++;
-  }
-
-  /** Replaces the newest event (there must be one). */
-  replaceNewest(values: Float64Array, t: number): void {
-    this.put((this.head + this.n - 1) % this.cap, values, t);
-  }
-
-  get oldestT(): number {
-    return this.t[this.head]!;
-  }
-
-  get oldest(): Float64Array {
-    return this.v.subarray(this.head * this.size, (this.head + 1) * this.size);
-  }
-
-  shift(): void {
-    this.head = (this.head + 1) % this.cap;
-    this.n--;
-  }
-
-  clear(): void {
-    this.head = 0;
-    this.n = 0;
-  }
-
-  private put(k: number, values: Float64Array, t: number): void {
-    this.t[k] = t;
-    this.v.set(values, k * this.size);
-  }
-
-  private grow(): void {
-    const cap = this.cap * 2;
-    const t = new Float64Array(cap);
-    const v = new Float64Array(cap * this.size);
-    for (let i = 0; i < this.n; i++) {
-      const k = (this.head + i) % this.cap;
-      t[i] = this.t[k]!;
-      v.set(this.v.subarray(k * this.size, (k + 1) * this.size), i * this.size);
-    }
-    this.t = t;
-    this.v = v;
-    this.cap = cap;
-    this.head = 0;
-  }
+/** No Python here (the browser build): the block loads so that the rest runs, and says why. */
+function withoutPython(ctx: BlockContext, shape: Shape): BlockInstance {
+  ctx.output(shape);
+  const text =
+    "Python is not available here (browser build): run the pipeline with mosaic run or the desktop app";
+  ctx.setText(text);
+  return {
+    start() {
+      ctx.setText(text);
+    },
+  };
 }
 
 export const Python = defineBlock({
@@ -262,370 +209,11 @@ export const Python = defineBlock({
         `the shape of its input ${input.source} is unknown (a feedback cycle): put the Python block after the cycle's first block`,
       );
     }
-    const inShape: Shape = input.shape;
-    const inSize = shapeSize(inShape);
-    const budgetMs = p.Budget ?? (ctx.desiredRate > 0 ? 1000 / ctx.desiredRate : Infinity);
-    const budget = budgetMs < Infinity ? budgetMs : undefined;
-    const hardLimitMs =
-      p.HardLimit ??
-      (budget !== undefined ? Math.max(HARD_BUDGETS * budget, HARD_MIN_MS) : HARD_NO_BUDGET_MS);
     const bridge = ctx.io.python;
-    const declared: Shape | undefined = p.OutputShape
-      ? { rows: p.OutputShape[0], cols: p.OutputShape[1] }
-      : undefined;
-
-    if (!bridge) {
-      // No Python here (the browser build): the block loads so that the rest runs.
-      ctx.output(declared ?? inShape);
-      const text =
-        "Python is not available here (browser build): run the pipeline with mosaic run or the desktop app";
-      ctx.setText(text);
-      return {
-        start() {
-          ctx.setText(text);
-        },
-      };
-    }
-
-    // Calls sent, oldest first: input timestamps, send times, and whether the call was already
-    // counted as over budget while it ran (results come back in order).
-    const cap = p.MaxInFlight;
-    const sentT = new Float64Array(cap);
-    const sentAt = new Float64Array(cap);
-    const counted = new Uint8Array(cap);
-    let head = 0;
-    let count = 0;
-    // Inputs waiting for a call: in real time one (newer ones replace it); under the virtual
-    // clock all of them (the engine waits for every call).
-    const waiting = new EventQueue(inSize, ctx.virtual ? 16 : 1);
-    // Results held for `flush` under the virtual clock (emitted in the engine's order).
-    let held: EventQueue | undefined;
-    // Last good output (OnError: hold).
-    let lastGood: Float64Array | undefined;
-    let haveGood = false;
-
-    let runningNow = false;
-    let calls = 0;
-    let errors = 0;
-    let overBudget = 0;
-    let skipped = 0;
-    let crashes = 0;
-    let state = "loading";
-    /** The sidecar failed to restart: under the virtual clock, inputs are not waited for. */
-    let down = false;
-    let lastError = "";
-    let lastWarnAt = -Infinity;
-    let lastText = "";
-    /** How long the oldest call has been running, when that is longer than the budget (ms). */
-    let lateFor = 0;
-    const rtt = new Float64Array(TIMES);
-    const py = new Float64Array(TIMES);
-    const scratch = new Float64Array(TIMES);
-    let timesN = 0;
-    let timesAt = 0;
-
-    let sidecar: PythonSidecar | undefined;
-    // eslint-disable-next-line prefer-const
-    let out: ReturnType<typeof ctx.output>;
-
-    let pctText = "";
-    let lastPct = -Infinity;
-    const refresh = (force = false): void => {
-      const now = performance.now();
-      // Percentiles at most every 100 ms (a sort of the last 256 call times); counters always.
-      if (force || now - lastPct >= 100 || timesN < 8) {
-        lastPct = now;
-        const [p50, p99] = percentiles(rtt, timesN, scratch);
-        const [py50] = percentiles(py, timesN, scratch);
-        pctText = `p50 ${ms(p50)} p99 ${ms(p99)} (Python ${ms(py50)})`;
-      }
-      let text: string;
-      if (state === "ready") {
-        text = `pid ${sidecar?.pid ?? "?"}`;
-        if (lateFor > 0) text += ` · call running for ${running(lateFor)}`;
-        text += ` · ${pctText}`;
-        text += ` · ${overBudget} over budget${budget !== undefined ? ` (${ms(budget)})` : ""}`;
-      } else {
-        text = state;
-      }
-      if (skipped > 0) text += ` · ${skipped} skipped`;
-      if (crashes > 0) text += ` · ${crashes} restart${crashes > 1 ? "s" : ""}`;
-      if (errors > 0) text += ` · ${errors} errors (last: ${lastError})`;
-      if (text !== lastText) {
-        lastText = text;
-        ctx.setText(text);
-      }
-    };
-
-    /** Under the virtual clock: how many results the engine must wait for. */
-    const awaiting = (): void => {
-      if (ctx.virtual) ctx.setAwaiting(runningNow ? count + waiting.n : 0);
-    };
-
-    const send = (values: Float64Array, t: number): boolean => {
-      if (count >= cap || !sidecar?.ready) return false;
-      const k = (head + count) % cap;
-      sentT[k] = t;
-      sentAt[k] = performance.now();
-      counted[k] = 0;
-      count++;
-      if (sidecar.call(values) < 0) {
-        count--;
-        return false;
-      }
-      return true;
-    };
-
-    /**
-     * Takes the oldest outstanding call: its input timestamp, its round-trip time (ms), and
-     * whether it was counted over budget while it ran.
-     */
-    const take = (): [number, number, boolean] | undefined => {
-      if (count === 0) return undefined;
-      const t = sentT[head]!;
-      const took = performance.now() - sentAt[head]!;
-      const wasCounted = counted[head] === 1;
-      head = (head + 1) % cap;
-      count--;
-      lateFor = 0;
-      return [t, took, wasCounted];
-    };
-
-    const sendWaiting = (): void => {
-      while (waiting.n > 0 && send(waiting.oldest, waiting.oldestT)) waiting.shift();
-    };
-
-    const emit = (t: number, values: Float64Array): void => {
-      if (!runningNow) return;
-      if (held) {
-        held.push(values, t);
-        return;
-      }
-      const f = out.frame(1);
-      f.t[0] = t;
-      f.v.set(values);
-      out.emit(f);
-    };
-
-    const warnOutput = (message: string): void => {
-      const now = performance.now();
-      if (now - lastWarnAt < WARN_EVERY_MS) return;
-      lastWarnAt = now;
-      ctx.warn(message);
-    };
-
-    /**
-     * An error: counted by the runtime like an exception in `process`; the status counts the
-     * function's errors (a lost process shows as a restart).
-     */
-    const failed = (message: string, traceback = "", restart = false): void => {
-      if (!restart) {
-        errors++;
-        lastError = message;
-      }
-      ctx.error(message, traceback.trimEnd() || undefined);
-    };
-
-    /** The oldest call, still running past the budget: counted now, and marks it stumbling. */
-    const onLate = (_id: number, runningMs: number): void => {
-      if (count === 0 || budget === undefined) return;
-      if (counted[head] === 0) {
-        counted[head] = 1;
-        overBudget++;
-      }
-      lateFor = runningMs;
-      ctx.reportCompute(runningMs, budget);
-      refresh(true);
-    };
-
-    const onResult = (_id: number, values: Float64Array, computeUs: number): void => {
-      const taken = take();
-      if (!taken) return;
-      const [t, took, wasCounted] = taken;
-      calls++;
-      rtt[timesAt] = took;
-      py[timesAt] = computeUs / 1000;
-      timesAt = (timesAt + 1) % TIMES;
-      if (timesN < TIMES) timesN++;
-      if (took > budgetMs && !wasCounted) overBudget++;
-      // The call's duration is this block's compute: a call over budget marks it stumbling.
-      ctx.reportCompute(took, budget);
-      if (!lastGood) lastGood = new Float64Array(values.length);
-      lastGood.set(values);
-      haveGood = true;
-      emit(t, values);
-      sendWaiting();
-      awaiting();
-      refresh();
-    };
-
-    const onError = (id: number, e: PythonCallError): void => {
-      if (id === 0) {
-        // Not a call: init raised on reset.
-        failed(e.message, e.traceback);
-        refresh(true);
-        return;
-      }
-      const taken = take();
-      // A call lost to a crash or a kill: the restart's report counts it (once per process).
-      if (e.kind !== "crash" && e.kind !== "timeout") failed(e.message, e.traceback);
-      if (taken) {
-        if (taken[1] > budgetMs && !taken[2]) overBudget++;
-        ctx.reportCompute(taken[1], budget);
-        if (p.OnError === "hold" && haveGood && lastGood) emit(taken[0], lastGood);
-      }
-      sendWaiting();
-      awaiting();
-      refresh(true);
-    };
-
+    if (!bridge) return withoutPython(ctx, declaredShape(p) ?? input.shape);
     refuseInstalledModule(ctx, p.Module);
-    let loadPromise: Promise<PythonSidecar>;
-    try {
-      loadPromise = bridge.load({
-        module: looksLikeFile(p.Module) ? ctx.resources.resolve(p.Module) : p.Module,
-        function: p.Function,
-        ...(p.Init !== undefined ? { init: p.Init } : {}),
-        params: p.Params,
-        inputShape: inShape,
-        ...(declared ? { outputShape: declared } : {}),
-        cwd: ctx.resources.resolve("."),
-        label: `block '${ctx.name}'`,
-        hardLimitMs,
-        ...(budget !== undefined ? { lateAfterMs: budget } : {}),
-        memoryLimitMb: p.MemoryLimit,
-        onResult,
-        onLate,
-        onError,
-        onStatus(s, message) {
-          if (!sidecar) return; // the load itself: its outcome is what `load` returns
-          if (s === "restarting") {
-            const text = message ?? "the Python sidecar stopped; restarting";
-            if (state === "ready") {
-              // The process died (or was killed): one error, whatever it had in flight.
-              crashes++;
-              failed(text, "", true);
-            } else {
-              // A restart failed: the same outage goes on.
-              ctx.warn(text);
-              down = true;
-              if (ctx.virtual && waiting.n > 0) {
-                skipped += waiting.n;
-                waiting.clear();
-              }
-            }
-            state = text;
-            count = 0;
-            head = 0;
-            lateFor = 0;
-          } else if (s === "ready") {
-            state = "ready";
-            down = false;
-            if (message) ctx.warn(`Python sidecar ${message}`);
-            sendWaiting();
-          } else if (s === "closed") {
-            state = "closed";
-          }
-          awaiting();
-          refresh(true);
-        },
-        onOutput(line) {
-          warnOutput(`python: ${line}`);
-        },
-      });
-      sidecar = await loadPromise;
-    } catch (e) {
-      const kind = (e as { kind?: unknown }).kind;
-      const message = e instanceof Error ? e.message : String(e);
-      throw new BlockConfigError(
-        `Python: ${message}`,
-        paramOf(typeof kind === "string" ? kind : "", p),
-      );
-    }
-    const sc: PythonSidecar = sidecar;
-    state = "ready";
-    out = ctx.output(sc.outputShape);
-    if (declared && shapeSize(declared) !== shapeSize(sc.outputShape)) {
-      sc.close();
-      throw new BlockConfigError(
-        `Python: the function returns ${formatShape(sc.outputShape)}, not ${formatShape(declared)}`,
-        "OutputShape",
-      );
-    }
-    if (ctx.virtual) held = new EventQueue(shapeSize(sc.outputShape), 16);
-    refresh(true);
-
-    return {
-      start() {
-        runningNow = true;
-        refresh(true);
-      },
-      stop() {
-        runningNow = false;
-        awaiting();
-      },
-      process(frame: Frame) {
-        const stride = frame.stride;
-        for (let e = 0; e < frame.n; e++) {
-          const v = frame.v.subarray(e * stride, e * stride + inSize);
-          const t = frame.t[e]!;
-          if (waiting.n === 0 && send(v, t)) continue;
-          if (ctx.virtual) {
-            // Every input gets its call (unless the sidecar cannot be restarted).
-            if (down) skipped++;
-            else waiting.push(v, t);
-          } else if (waiting.n > 0) {
-            // Busy (or restarting): this input waits, replacing an older waiting one.
-            skipped++;
-            waiting.replaceNewest(v, t);
-          } else {
-            waiting.push(v, t);
-          }
-        }
-        awaiting();
-        refresh();
-      },
-      // Under the virtual clock results are held until the engine has delivered everything it
-      // had (it waits for them), then go out here, in the engine's order of blocks.
-      ...(held
-        ? {
-            flush() {
-              const h = held!;
-              if (h.n === 0 || !runningNow) {
-                h.clear();
-                return;
-              }
-              const f = out.frame(h.n);
-              for (let i = 0; i < f.n; i++) {
-                f.t[i] = h.oldestT;
-                f.v.set(h.oldest, i * f.stride);
-                h.shift();
-              }
-              out.emit(f);
-            },
-          }
-        : {}),
-      reset() {
-        waiting.clear();
-        held?.clear();
-        haveGood = false;
-        awaiting();
-        sc.reset();
-      },
-      dispose() {
-        runningNow = false;
-        sc.close();
-      },
-      actions: {
-        info: {
-          label: "Sidecar info",
-          description: "Shows the Python process, its versions and counters",
-          run: () =>
-            `${p.Module}:${p.Function} in pid ${sc.pid ?? "?"} (${sc.version}); ` +
-            `${formatShape(inShape)} → ${formatShape(sc.outputShape)}; ${calls} calls, ` +
-            `${overBudget} over budget, ${errors} errors, ${skipped} skipped, ${crashes} restarts`,
-        },
-      },
-    };
+    const run = new PythonRun(ctx, settings(ctx, p, input.shape));
+    await run.load(bridge, ctx.resources.resolve("."));
+    return run.instance();
   },
 });
