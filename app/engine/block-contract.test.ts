@@ -2,7 +2,9 @@ import { describe, expect, test } from "vitest";
 import { z } from "zod";
 import { defineBlock } from "./block";
 import { runBlockContract, type CheckResult } from "./block-contract";
+import { errorMessage } from "./diagnostics";
 import { vectorShape } from "./frame";
+import { LegacyParamsError } from "./pipeline/legacy";
 import { TestGain, testCatalog } from "./test-blocks";
 import { noResources } from "./testing";
 
@@ -60,7 +62,20 @@ const Unchecked = defineBlock({
 
 describe("the block contract as a program", () => {
   test("a block that keeps it passes every check", async () => {
-    const Gain = defineBlock({ ...TestGain, type: "Gain2", legacyForm: "[gain:k]" });
+    // Its positional form refuses an unknown operation with a LegacyParamsError, as the contract
+    // asks (a plain Error there fails the garbage check, as one from create() does).
+    const Gain = defineBlock({
+      ...TestGain,
+      type: "Gain2",
+      legacyForm: "[gain:k]",
+      legacyParams: (a: readonly string[]) => {
+        try {
+          return TestGain.legacyParams!(a);
+        } catch (e) {
+          throw e instanceof LegacyParamsError ? e : new LegacyParamsError(errorMessage(e));
+        }
+      },
+    });
     const rs = await runBlockContract(Gain, { params: { Gain: 3 } }, noResources, testCatalog);
     expect(rs.filter((r) => !r.ok)).toEqual([]);
     expect(rs.map((r) => r.name)).toEqual([
