@@ -102,9 +102,10 @@ export class PlayerRun implements PlayState {
     else if (this.throttle.due(f.t[n - 1]!)) this.describe();
   }
 
+  /** As a fresh start: back to the first row, the position not announced (no one moved it). */
   reset(): void {
     this.paused = false;
-    this.rewind();
+    this.rewind(false);
   }
 
   dispose(): void {
@@ -318,8 +319,8 @@ export class PlayerRun implements PlayState {
     if (!v) this.schedule();
   }
 
-  /** Back to the first row of the first pass. */
-  private rewind(): void {
+  /** Back to the first row of the first pass (`announce`: the position goes out at once). */
+  private rewind(announce = true): void {
     if (this.row !== 0 || this.loops !== 0 || this.done) this.src.rewind();
     this.row = 0;
     this.loops = 0;
@@ -327,7 +328,11 @@ export class PlayerRun implements PlayState {
     this.failed = undefined;
     this.throttle.reset();
     if (!this.timed && this.started) this.base = this.ctx.now();
-    this.moved();
+    if (announce) this.moved();
+    else {
+      this.describe();
+      this.schedule();
+    }
   }
 
   /** After a seek or a rewind: the text, the next wake-up and the position, at once. */
