@@ -200,8 +200,8 @@ Rec:
     }, 180_000);
 
     const labels = [
-      ...Array.from({ length: 32 }, (_, c) => `Emg ${c + 1}`),
-      ...Array.from({ length: 8 }, (_, c) => `Trigno ${c + 1}`),
+      ...Array.from({ length: 32 }, (_, c) => `Emg EMG ${c + 1}`),
+      ...Array.from({ length: 8 }, (_, c) => `Trigno EMG ${c + 1}`),
     ];
     const rates = [...labels.map((l) => (l.startsWith("Emg") ? 2000 : 52000 / 27))];
 
@@ -212,8 +212,8 @@ Rec:
       const t0 = emg.t[0]!;
       expect(t0).toBe(START);
       const physical: Record<string, number[]> = {};
-      columns(emg.v, 32).forEach((c, k) => (physical[`Emg ${k + 1}`] = c));
-      columns(trigno.v, 8).forEach((c, k) => (physical[`Trigno ${k + 1}`] = c));
+      columns(emg.v, 32).forEach((c, k) => (physical[`Emg EMG ${k + 1}`] = c));
+      columns(trigno.v, 8).forEach((c, k) => (physical[`Trigno EMG ${k + 1}`] = c));
       const annotations: [number, string][] = [];
       phase.v.forEach((v, i) => {
         if (i === 0 || v[0] !== phase.v[i - 1]![0]) {

@@ -186,6 +186,29 @@ function metaLabel(i: InputInfo, c: number, channels: number): string | undefine
   return labels[c];
 }
 
+/**
+ * The sources' own channel names (port meta) of every signal, or undefined per channel without
+ * one; an input sharing a name with another ("EMG 1" of two simulators) has all its names
+ * qualified by its source's name ("Trigno EMG 1").
+ */
+function ownLabels(ctx: BlockContext, signals: readonly SignalSlot[]): (string | undefined)[][] {
+  const own = signals.map((s) => {
+    const info = ctx.inputs[s.index]!;
+    return Array.from({ length: s.channels }, (_, c) => metaLabel(info, c, s.channels));
+  });
+  const inputsWith = new Map<string, number>();
+  for (const labels of own) {
+    for (const l of new Set(labels)) {
+      if (l !== undefined) inputsWith.set(l, (inputsWith.get(l) ?? 0) + 1);
+    }
+  }
+  return own.map((labels, i) => {
+    if (!labels.some((l) => l !== undefined && inputsWith.get(l)! > 1)) return labels;
+    const source = ctx.inputs[signals[i]!.index]!.source;
+    return labels.map((l) => (l === undefined ? l : `${source} ${l}`));
+  });
+}
+
 /** Labels of every signal channel: Labels, the source's names, or 'Input k'; unique, 16 characters. */
 function channelLabels(ctx: BlockContext, p: EdfParams, signals: readonly SignalSlot[]): string[] {
   const total = signals.reduce((a, s) => a + s.channels, 0);
@@ -198,21 +221,21 @@ function channelLabels(ctx: BlockContext, p: EdfParams, signals: readonly Signal
     }
     return p.Labels.map(toAscii);
   }
+  const own = ownLabels(ctx, signals);
   const seen = new Set<string>();
   const out: string[] = [];
-  for (const s of signals) {
-    const info = ctx.inputs[s.index]!;
-    const name = toAscii(info.source);
+  signals.forEach((s, i) => {
+    const name = toAscii(ctx.inputs[s.index]!.source);
     for (let c = 0; c < s.channels; c++) {
-      const own = metaLabel(info, c, s.channels);
-      const suffix = own !== undefined || s.channels === 1 ? "" : ` ${c + 1}`;
-      const base = own !== undefined ? toAscii(own) : name;
+      const mine = own[i]![c];
+      const suffix = mine !== undefined || s.channels === 1 ? "" : ` ${c + 1}`;
+      const base = mine !== undefined ? toAscii(mine) : name;
       let label = base.slice(0, 16 - suffix.length) + suffix;
       for (let k = 2; seen.has(label); k++) label = `${base.slice(0, 12)}~${k}${suffix}`.slice(-16);
       seen.add(label);
       out.push(label);
     }
-  }
+  });
   return out;
 }
 
