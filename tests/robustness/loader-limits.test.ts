@@ -194,7 +194,7 @@ describe("limits: refused fast, positioned, naming the limit", () => {
     expect(e.map(formatDiagnostic)).toEqual([
       `p.yaml:1:${52 + LOAD_LIMITS.maxDepth - 1}: error: nesting too deep: lists and mappings more than ${LOAD_LIMITS.maxDepth} levels inside one another (a pipeline needs about 6)`,
     ]);
-    expect(s).toBeLessThan(2);
+    expect(s).toBeLessThan(10); // refused, not hung (under a second on a quiet machine)
     let block = "";
     for (let i = 0; i < 40; i++) block += `${" ".repeat(i)}k${i}:\n`;
     const e2 = errorsOf(block);

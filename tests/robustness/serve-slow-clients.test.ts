@@ -199,10 +199,10 @@ describe("clients that stop reading", () => {
     const raw = await RawClient.open(served);
     raw.send({ type: "hello", version: 1 });
     raw.sock.pause();
-    const t0 = Date.now();
     for (let id = 1; id <= 150; id++) raw.send({ type: "catalog", id });
     await until(() => served.stats().disconnected.length > before.disconnected.length);
-    expect(Date.now() - t0).toBeLessThan(LIMITS.stalledMs);
+    // The size rule, not the stall rule (which would say "stalled: …" after stalledMs): how long
+    // the host takes to answer 150 catalog requests depends on the machine, so it is not timed.
     expect(served.stats().disconnected.at(-1)).toMatch(
       /^too slow: \d+\.\d MiB waiting to be sent$/,
     );
