@@ -66,6 +66,21 @@ async function waitViewportChange(page: Page, before: { x: number; y: number }):
   );
 }
 
+/**
+ * The viewport once it has stopped moving (the same for 150 ms): a minimap click animates the
+ * view there, and a reading taken on the way is not where it ends.
+ */
+async function settledViewport(page: Page): Promise<{ x: number; y: number; zoom: number }> {
+  let last = await viewport(page);
+  for (let i = 0; i < 100; i++) {
+    await page.waitForTimeout(150);
+    const v = await viewport(page);
+    if (v.x === last.x && v.y === last.y && v.zoom === last.zoom) return v;
+    last = v;
+  }
+  throw new Error(`the viewport never settled (last ${JSON.stringify(last)})`);
+}
+
 /** Centre of an element on screen. */
 async function centre(page: Page, selector: string): Promise<{ x: number; y: number }> {
   const b = (await page.locator(selector).boundingBox())!;
@@ -111,18 +126,18 @@ describe.skipIf(!haveChromium)("large flows on the BlockTable (Chromium)", () =>
       "pipelines/examples/training.yaml",
     );
     await page.waitForSelector(".block-table.is-fitted .graph-minimap svg");
-    const before = await viewport(page);
+    const before = await settledViewport(page);
     const map = (await page.locator(".graph-minimap svg").boundingBox())!;
     // A click near the minimap's top-left corner brings that part of the canvas to the middle.
     await page.mouse.click(map.x + 8, map.y + 8);
     await waitViewportChange(page, before);
-    const clicked = await viewport(page);
+    const clicked = await settledViewport(page);
     expect(clicked.x).toBeGreaterThan(before.x);
     expect(clicked.zoom).toBeCloseTo(before.zoom, 5);
     // Dragging the minimap's view box pans the other way round (the box follows the pointer).
     await drag(page, { x: map.x + map.width / 2, y: map.y + map.height / 2 }, 40, 25);
     await waitViewportChange(page, clicked);
-    const dragged = await viewport(page);
+    const dragged = await settledViewport(page);
     expect(dragged.x).toBeLessThan(clicked.x);
     expect(dragged.y).toBeLessThan(clicked.y);
     expect(errors).toEqual([]);

@@ -26,7 +26,11 @@ function Minimap({ duration }: { duration: number }) {
       zoomable
       ariaLabel="Minimap of the pipeline: click or drag to move the view"
       nodeStrokeWidth={3}
-      onClick={(_e, p) => void flow.setCenter(p.x, p.y, { zoom: flow.getZoom(), duration })}
+      // Linear: the view slides there at the same zoom (the default smooth path zooms out on
+      // the way and back in, so a click seemed to change the zoom while the view moved).
+      onClick={(_e, p) =>
+        void flow.setCenter(p.x, p.y, { zoom: flow.getZoom(), duration, interpolate: "linear" })
+      }
     />
   );
 }
