@@ -5,7 +5,7 @@
  * The served root is a temporary folder that links every entry of dist/web and adds `e2e/` with
  * the test pipelines of ./fixtures, so the build folder itself is never written.
  */
-import { execFileSync } from "node:child_process";
+import { execFileSync, type ChildProcess } from "node:child_process";
 import {
   cpSync,
   existsSync,
@@ -179,4 +179,21 @@ export async function statuses(page: Page): Promise<Record<string, string>> {
       els.map((e) => [e.getAttribute("data-block"), e.getAttribute("data-status")]),
     ),
   );
+}
+
+/** The URL `mosaic serve` prints ("MOSAIC is at URL"); rejects with what it printed after `ms`. */
+export function servedUrl(cli: ChildProcess, ms = 30_000): Promise<string> {
+  let out = "";
+  return new Promise<string>((resolve, reject) => {
+    const t = setTimeout(() => reject(new Error(`no URL printed: ${out}`)), ms);
+    cli.stdout!.on("data", (d: Buffer) => {
+      out += d.toString();
+      const m = /MOSAIC is at (\S+)/.exec(out);
+      if (m) {
+        clearTimeout(t);
+        resolve(m[1]!);
+      }
+    });
+    cli.stderr!.on("data", (d: Buffer) => (out += d.toString()));
+  });
 }

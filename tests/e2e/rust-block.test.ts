@@ -23,6 +23,7 @@ import {
   serveApp,
   type Chromium,
   type Served,
+  servedUrl,
 } from "./harness";
 
 /** The pipeline of the guide's Rust section (the YAML block that names tkeo/block.ts). */
@@ -87,20 +88,7 @@ describe.skipIf(!haveChromium)("a Rust block in mosaic serve's UI (Chromium)", (
     cargoBuild(join(dir, "tkeo"));
     writeFileSync(join(dir, "pipeline.yaml"), guidePipeline());
     cli = startCli(["serve", join(dir, "pipeline.yaml"), "--port", "0"]);
-    let out = "";
-    url = await new Promise<string>((resolve, reject) => {
-      const t = setTimeout(() => reject(new Error(`no URL printed: ${out}`)), 30_000);
-      const seen = (d: Buffer) => {
-        out += d.toString();
-        const m = /MOSAIC is at (\S+)/.exec(out);
-        if (m) {
-          clearTimeout(t);
-          resolve(m[1]!);
-        }
-      };
-      cli.stdout!.on("data", seen);
-      cli.stderr!.on("data", (d: Buffer) => (out += d.toString()));
-    });
+    url = await servedUrl(cli, 30_000);
     browser = await launchChromium();
   }, 300_000);
 

@@ -14,6 +14,7 @@ import {
   openApp,
   statuses,
   type Chromium,
+  servedUrl,
 } from "./harness";
 
 describe.skipIf(!haveChromium)("mosaic serve in Chromium", () => {
@@ -25,20 +26,7 @@ describe.skipIf(!haveChromium)("mosaic serve in Chromium", () => {
     ensureWebBuild();
     requireBuild();
     cli = startCli(["serve", "pipelines/demo.yaml", "--port", "0"]);
-    let out = "";
-    url = await new Promise<string>((resolve, reject) => {
-      const t = setTimeout(() => reject(new Error(`no URL printed: ${out}`)), 20_000);
-      const seen = (d: Buffer) => {
-        out += d.toString();
-        const m = /MOSAIC is at (\S+)/.exec(out);
-        if (m) {
-          clearTimeout(t);
-          resolve(m[1]!);
-        }
-      };
-      cli.stdout!.on("data", seen);
-      cli.stderr!.on("data", (d: Buffer) => (out += d.toString()));
-    });
+    url = await servedUrl(cli, 20_000);
     browser = await launchChromium();
   }, 60_000);
 

@@ -20,6 +20,7 @@ import {
   serveApp,
   type Chromium,
   type Served,
+  servedUrl,
 } from "./harness";
 
 /** The guide's block and pipeline, written into `dir`. */
@@ -59,20 +60,7 @@ describe.skipIf(!haveChromium)("a user's block in mosaic serve's UI (Chromium)",
     dir = tempDir("mosaic-e2e-user-blocks-");
     projectFromGuide(dir);
     cli = startCli(["serve", join(dir, "pipeline.yaml"), "--port", "0"]);
-    let out = "";
-    url = await new Promise<string>((resolve, reject) => {
-      const t = setTimeout(() => reject(new Error(`no URL printed: ${out}`)), 30_000);
-      const seen = (d: Buffer) => {
-        out += d.toString();
-        const m = /MOSAIC is at (\S+)/.exec(out);
-        if (m) {
-          clearTimeout(t);
-          resolve(m[1]!);
-        }
-      };
-      cli.stdout!.on("data", seen);
-      cli.stderr!.on("data", (d: Buffer) => (out += d.toString()));
-    });
+    url = await servedUrl(cli, 30_000);
     browser = await launchChromium();
   }, 60_000);
 
