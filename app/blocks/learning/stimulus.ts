@@ -18,7 +18,7 @@ import {
   targetColumnLabels,
   targetVector,
   unknownLabel,
-} from "./trigger";
+} from "./labels";
 
 /**
  * What a Stimulus offers by its name (shared/named.ts, kind "Stimulus"): its trigger frames (the

@@ -1,122 +1,18 @@
 import { z } from "zod";
-import {
-  BlockConfigError,
-  closest,
-  defineBlock,
-  LegacyParamsError,
-  legacyPair,
-  legacyVector,
-  vectorShape,
-} from "../../engine";
-import { indexArg } from "../shared/args";
-import { inputName, signalInput } from "../shared/inputs";
+import { defineBlock, LegacyParamsError } from "../../engine";
 import { index } from "../shared/params";
-import { formatVector } from "../shared/text";
+import {
+  checkLabels,
+  labelsSchema,
+  legacyLabel,
+  unknownLabel,
+  type AddIssue,
+  type Issue,
+} from "./labels";
+import { TriggerRun } from "./trigger-run";
 
-// ---------------------------------------------------------------------------------------------
-// Labels, shared with the Stimulus
-
-/** Most labels a Trigger or Stimulus may have, and most values in a label's target vector. */
-export const MAX_LABELS = 1000;
-export const MAX_TARGET = 4096;
-
-/** A target vector: what a label means for a model (one value per output, e.g. a one-hot). */
-export const targetVector = () => z.array(z.number()).min(1).max(MAX_TARGET);
-
-/** `Labels`: a mapping from label name to target vector (in the order written). */
-export const labelsSchema = () => z.record(z.string().min(1), targetVector());
-
-type Issue = { code: "custom"; path: (string | number)[]; message: string };
-type AddIssue = (issue: Issue) => void;
-
-/** Checks a Labels mapping: at least one label, at most MAX_LABELS, all of the same width. */
-export function checkLabels(
-  labels: Record<string, number[]>,
-  param: string,
-  addIssue: AddIssue,
-): void {
-  const names = Object.keys(labels);
-  if (names.length === 0) {
-    addIssue({ code: "custom", path: [param], message: "needs at least one label" });
-    return;
-  }
-  if (names.length > MAX_LABELS) {
-    addIssue({
-      code: "custom",
-      path: [param],
-      message: `has ${names.length} labels; at most ${MAX_LABELS} are allowed`,
-    });
-    return;
-  }
-  const width = labels[names[0]!]!.length;
-  for (const n of names) {
-    const w = labels[n]!.length;
-    if (w !== width) {
-      addIssue({
-        code: "custom",
-        path: [param, n],
-        message:
-          `label '${n}' has ${w} values, but '${names[0]}' has ${width}: every target vector ` +
-          "must have the same length",
-      });
-    }
-  }
-}
-
-/**
- * Names of a target vector's columns, for panels and recordings (PortMeta labels): column k is
- * named after the label whose target is one-hot at k (1 there, 0 elsewhere: fist [1, 0, 0] names
- * column 0 "fist"). Undefined unless every column has exactly one such label.
- */
-export function targetColumnLabels(
-  names: readonly string[],
-  targets: readonly ArrayLike<number>[],
-): string[] | undefined {
-  const width = targets[0]?.length ?? 0;
-  if (width === 0) return undefined;
-  const cols: (string | null | undefined)[] = new Array<undefined>(width).fill(undefined);
-  names.forEach((name, i) => {
-    const v = targets[i]!;
-    let hot = -1;
-    for (let k = 0; k < v.length; k++) {
-      if (v[k] === 1 && hot === -1) hot = k;
-      else if (v[k] !== 0) return;
-    }
-    if (hot >= 0) cols[hot] = cols[hot] === undefined ? name : null;
-  });
-  return cols.every((c) => typeof c === "string") ? (cols as string[]) : undefined;
-}
-
-/** "unknown label 'fsit' (labels: rest, fist); did you mean 'fist'?" */
-export function unknownLabel(name: string, names: readonly string[]): string {
-  const s = closest(name, names);
-  return (
-    `unknown label '${name}' (labels: ${names.slice(0, 20).join(", ")}` +
-    `${names.length > 20 ? ", …" : ""})` +
-    (s !== undefined ? `; did you mean '${s}'?` : "")
-  );
-}
-
-/** MOSAIC's `name:a;b;c` (a label and its target vector), argument `i` (0-based) of Params. */
-export function legacyLabel(arg: string, i: number, param: string): [string, number[]] {
-  if (!arg.includes(":")) {
-    throw new LegacyParamsError(
-      `argument ${i + 1} '${arg}' is not 'name:a;b;c' (a label and its target vector)`,
-      param,
-    );
-  }
-  const { key, value } = legacyPair(arg);
-  if (key === "") {
-    throw new LegacyParamsError(`argument ${i + 1} '${arg}' has no label name`, param);
-  }
-  return [key, legacyVector(value, `the target of label '${key}'`, param)];
-}
-
-/** Seconds for status texts: 2.4 → "2.4 s". */
-export const seconds = (s: number): string => `${Number.isFinite(s) ? s.toFixed(1) : "∞"} s`;
-
-// ---------------------------------------------------------------------------------------------
-// Trigger
+// Label helpers the TAC and tests import from here (they live in labels.ts).
+export { seconds, targetColumnLabels } from "./labels";
 
 const MAX_SCHEDULED = 100_000;
 
@@ -164,8 +60,6 @@ const condition = z
     message: "with both, Above must be below Below (the condition holds between them)",
   });
 
-type Condition = z.output<typeof condition>;
-
 const params = z
   .strictObject({
     Labels: labelsSchema().describe(
@@ -209,76 +103,48 @@ const params = z
     if (p.Initial !== undefined && !names.includes(p.Initial)) {
       add({ code: "custom", path: ["Initial"], message: unknownLabel(p.Initial, names) });
     }
-    const s = p.Schedule;
-    if (s === undefined) return;
-    if (Array.isArray(s)) {
-      s.forEach((e, i) => {
-        if (!names.includes(e.Label)) {
-          add({
-            code: "custom",
-            path: ["Schedule", i, "Label"],
-            message: unknownLabel(e.Label, names),
-          });
-        }
-      });
-    } else {
-      const seq = s.Sequence ?? names;
-      seq.forEach((n, i) => {
-        if (!names.includes(n)) {
-          add({
-            code: "custom",
-            path: ["Schedule", "Sequence", i],
-            message: unknownLabel(n, names),
-          });
-        }
-      });
-      if (seq.length * s.Repetitions > MAX_SCHEDULED) {
+    if (p.Schedule !== undefined) checkSchedule(p.Schedule, names, add);
+  });
+
+export type TriggerParams = z.output<typeof params>;
+
+/** Every label the Schedule names is one of Labels, and a protocol is not too long. */
+function checkSchedule(
+  s: NonNullable<TriggerParams["Schedule"]>,
+  names: readonly string[],
+  add: AddIssue,
+): void {
+  if (Array.isArray(s)) {
+    s.forEach((e, i) => {
+      if (!names.includes(e.Label)) {
         add({
           code: "custom",
-          path: ["Schedule", "Repetitions"],
-          message:
-            `${seq.length} labels × ${s.Repetitions} repetitions make ` +
-            `${seq.length * s.Repetitions} captures; at most ${MAX_SCHEDULED} are allowed`,
+          path: ["Schedule", i, "Label"],
+          message: unknownLabel(e.Label, names),
         });
       }
-    }
-  });
-
-type Params = z.output<typeof params>;
-
-/** The schedule as start/stop events, relative to its start: times ascending, label or -1 (stop). */
-function expandSchedule(p: Params, names: readonly string[]): { t: number[]; label: number[] } {
-  const entries: { at: number; label: number; seconds: number }[] = [];
-  const s = p.Schedule;
-  if (s === undefined) return { t: [], label: [] };
-  if (Array.isArray(s)) {
-    for (const e of s)
-      entries.push({ at: e.At, label: names.indexOf(e.Label), seconds: e.Seconds });
-    entries.sort((a, b) => a.at - b.at); // stable: equal times keep the written order
-  } else {
-    const seq = (s.Sequence ?? names).map((n) => names.indexOf(n));
-    let t = s.Start;
-    for (let r = 0; r < s.Repetitions; r++) {
-      for (const label of seq) {
-        entries.push({ at: t, label, seconds: s.Seconds });
-        t += s.Seconds + s.Pause;
-      }
-    }
+    });
+    return;
   }
-  const t: number[] = [];
-  const label: number[] = [];
-  entries.forEach((e, i) => {
-    t.push(e.at);
-    label.push(e.label);
-    const end = e.at + e.seconds;
-    const next = entries[i + 1];
-    // A capture that runs into the next one is switched by it, without a stop in between.
-    if (next === undefined || next.at > end) {
-      t.push(end);
-      label.push(-1);
+  const seq = s.Sequence ?? names;
+  seq.forEach((n, i) => {
+    if (!names.includes(n)) {
+      add({
+        code: "custom",
+        path: ["Schedule", "Sequence", i],
+        message: unknownLabel(n, names),
+      });
     }
   });
-  return { t, label };
+  if (seq.length * s.Repetitions > MAX_SCHEDULED) {
+    add({
+      code: "custom",
+      path: ["Schedule", "Repetitions"],
+      message:
+        `${seq.length} labels × ${s.Repetitions} repetitions make ` +
+        `${seq.length * s.Repetitions} captures; at most ${MAX_SCHEDULED} are allowed`,
+    });
+  }
 }
 
 export const Trigger = defineBlock({
@@ -333,263 +199,7 @@ export const Trigger = defineBlock({
   views: ["label"],
   panel:
     "The selected label and whether it is capturing, with start, stop, previous, next and pulse buttons and the schedule's progress.",
-  create(ctx, p: Params) {
-    const names = Object.keys(p.Labels);
-    const L = names.length;
-    const T = p.Labels[names[0]!]!.length;
-    const targets = names.map((n) => Float64Array.from(p.Labels[n]!));
-    const initial = p.Initial !== undefined ? names.indexOf(p.Initial) : 0;
-    if (ctx.declaredRate === undefined) ctx.setDesiredRate(0);
-
-    // Condition input
-    const cond = ctx.inputs.length > 0 ? signalInput(ctx, 0) : null;
-    if (cond === null && p.Condition !== undefined) {
-      throw new BlockConfigError(
-        "Condition needs an input to compare (e.g. Inputs: [FootSwitch]); without one, leave it out",
-        "Condition",
-      );
-    }
-    const checkCondition = (c: Condition): Condition => {
-      if (cond && c.Channel >= cond.size) {
-        throw new BlockConfigError(
-          `Condition.Channel ${c.Channel} is out of range for input ${inputName(cond.info)} with ` +
-            `${cond.size} value${cond.size === 1 ? "" : "s"} (valid: 0–${cond.size - 1})`,
-          "Condition",
-        );
-      }
-      return c;
-    };
-    let condParams: Condition = checkCondition(p.Condition ?? { Channel: 0, Above: 0.5 });
-    let condOn = false;
-
-    const columns = targetColumnLabels(names, targets);
-    const target = ctx.output(vectorShape(T), "target", columns && { labels: columns });
-    const labelOut = ctx.output(vectorShape(1), "label");
-
-    const sched = expandSchedule(p, names);
-    const schedT = Float64Array.from(sched.t);
-    const schedLabel = Int32Array.from(sched.label);
-    let schedBase = NaN;
-    let schedNext = 0;
-    let schedStarts = 0;
-    let schedDone = 0;
-    for (let i = 0; i < schedLabel.length; i++) if (schedLabel[i]! >= 0) schedStarts++;
-
-    let selected = initial;
-    let capturing = false;
-    /** The label whose target was sent last (-1 after a stop). */
-    let lastSent = -1;
-    let pulseStop = NaN;
-    let pulseLength = 0;
-    let pulseSeconds = p.Pulse;
-    let running = false;
-
-    const describe = (): void => {
-      const name = `'${names[selected]}' (${selected + 1}/${L})`;
-      let s = capturing ? `capturing ${name}` : `${name} selected, not capturing`;
-      if (capturing && !Number.isNaN(pulseStop)) s += `, pulse of ${seconds(pulseLength)}`;
-      if (schedStarts > 0) s += `; schedule ${schedDone}/${schedStarts}`;
-      ctx.setText(s);
-    };
-
-    const send = (t: number, label: number): void => {
-      const f = target.frame(1);
-      f.t[0] = t;
-      if (label >= 0) f.v.set(targets[label]!);
-      else f.v.fill(NaN, 0, T);
-      target.emit(f);
-      const g = labelOut.frame(1);
-      g.t[0] = t;
-      g.v[0] = label >= 0 ? label : NaN;
-      labelOut.emit(g);
-    };
-    const startCapture = (t: number, label: number): void => {
-      pulseStop = NaN;
-      selected = label;
-      if (capturing && label === lastSent) return;
-      capturing = true;
-      lastSent = label;
-      send(t, label);
-    };
-    const stopCapture = (t: number): void => {
-      pulseStop = NaN;
-      if (!capturing) return;
-      capturing = false;
-      lastSent = -1;
-      send(t, -1);
-    };
-
-    /** Arms the one-shot for the earliest pending deadline (the schedule's next event or a pulse's stop). */
-    const arm = (): void => {
-      let next = Number.isNaN(pulseStop) ? Infinity : pulseStop;
-      if (running && schedNext < schedT.length)
-        next = Math.min(next, schedBase + schedT[schedNext]!);
-      if (next < Infinity) ctx.at(next, onDeadline);
-    };
-    const onDeadline = (t: number): void => {
-      for (;;) {
-        const ts = running && schedNext < schedT.length ? schedBase + schedT[schedNext]! : Infinity;
-        const tp = Number.isNaN(pulseStop) ? Infinity : pulseStop;
-        if (ts <= t && ts <= tp) {
-          const label = schedLabel[schedNext++]!;
-          if (label >= 0) {
-            schedDone++;
-            startCapture(t, label);
-          } else stopCapture(t);
-        } else if (tp <= t) {
-          stopCapture(t);
-        } else break;
-      }
-      describe();
-      arm();
-    };
-    const playSchedule = (from: number): void => {
-      schedBase = from;
-      schedNext = 0;
-      schedDone = 0;
-      arm();
-    };
-
-    const labelArg = (arg: unknown): number => {
-      if (arg === undefined || arg === null || arg === "") return selected;
-      if (typeof arg === "string" && !/^\s*\d+\s*$/.test(arg)) {
-        const i = names.indexOf(arg.trim());
-        if (i < 0) throw new Error(unknownLabel(arg.trim(), names));
-        return i;
-      }
-      return indexArg(arg, L, "a label name or index");
-    };
-    const secondsArg = (arg: unknown): number => {
-      if (arg === undefined || arg === null || arg === "") return pulseSeconds;
-      const v = typeof arg === "string" ? Number(arg) : arg;
-      if (typeof v !== "number" || !Number.isFinite(v) || v < 0 || v > 86_400) {
-        throw new Error(
-          `expected a duration in seconds from 0 to 86400, got ${typeof arg === "string" ? `'${arg}'` : String(arg)}`,
-        );
-      }
-      return v;
-    };
-    const move = (step: number): string => {
-      selected = (selected + step + L) % L;
-      if (capturing) startCapture(ctx.now(), selected);
-      describe();
-      return capturing ? `capturing '${names[selected]}'` : `selected '${names[selected]}'`;
-    };
-
-    describe();
-
-    return {
-      start() {
-        running = true;
-        if (schedT.length > 0) playSchedule(ctx.startTime);
-        describe();
-      },
-      stop() {
-        running = false;
-      },
-      process(f) {
-        if (cond === null) return;
-        const n = f.n;
-        const stride = f.stride;
-        const ch = condParams.Channel;
-        const above = condParams.Above;
-        const below = condParams.Below;
-        let changed = false;
-        for (let e = 0; e < n; e++) {
-          const x = f.v[e * stride + ch]!;
-          const on = (above === undefined || x > above) && (below === undefined || x < below);
-          if (on === condOn) continue;
-          condOn = on;
-          changed = true;
-          if (on) startCapture(f.t[e]!, selected);
-          else stopCapture(f.t[e]!);
-        }
-        if (changed) describe();
-      },
-      reset() {
-        stopCapture(ctx.now());
-        selected = initial;
-        condOn = false;
-        pulseStop = NaN;
-        if (running && schedT.length > 0) playSchedule(ctx.now());
-        describe();
-      },
-      setParam(name, value) {
-        if (name === "Pulse") pulseSeconds = value as number;
-        else if (name === "Condition") {
-          if (cond === null) {
-            throw new Error("this Trigger has no input: a Condition has nothing to compare");
-          }
-          const c = (value as Condition | undefined) ?? { Channel: 0, Above: 0.5 };
-          if (c.Channel >= cond.size) {
-            throw new Error(
-              `Condition.Channel ${c.Channel} is out of range for input ${inputName(cond.info)} ` +
-                `with ${cond.size} value${cond.size === 1 ? "" : "s"} (valid: 0–${cond.size - 1})`,
-            );
-          }
-          condParams = c;
-        }
-      },
-      actions: {
-        start: {
-          label: "Start",
-          description:
-            "Start capturing a label (a name or 0-based index; default: the selected label)",
-          run(arg) {
-            const i = labelArg(arg);
-            startCapture(ctx.now(), i);
-            describe();
-            return `capturing '${names[i]}' ${formatVector(targets[i]!)}`;
-          },
-        },
-        stop: {
-          label: "Stop",
-          description: "Stop capturing (sends all NaN)",
-          run() {
-            const was = capturing;
-            stopCapture(ctx.now());
-            describe();
-            return was ? `stopped '${names[selected]}'` : "not capturing";
-          },
-        },
-        select: {
-          label: "Select",
-          description: "Select a label (a name or index); while capturing, switch to it",
-          run(arg) {
-            const i = labelArg(arg);
-            return move(i - selected);
-          },
-        },
-        next: {
-          label: "Next label",
-          description: "Select the next label (after the last, the first)",
-          run() {
-            return move(1);
-          },
-        },
-        previous: {
-          label: "Previous label",
-          description: "Select the previous label (before the first, the last)",
-          run() {
-            return move(-1);
-          },
-        },
-        pulse: {
-          label: "Pulse",
-          description:
-            "Capture the selected label now and stop after N seconds (default: Pulse), like MOSAIC's number keys",
-          run(arg) {
-            const s = secondsArg(arg);
-            const t = ctx.now();
-            startCapture(t, selected);
-            pulseStop = t + s;
-            pulseLength = s;
-            describe();
-            arm();
-            return `capturing '${names[selected]}' for ${seconds(s)}`;
-          },
-        },
-      },
-    };
+  create(ctx, p: TriggerParams) {
+    return new TriggerRun(ctx, p).instance();
   },
 });
