@@ -3,6 +3,18 @@
 //! The normal matrix `A = S + λI` is kept as an **upper** Cholesky factor
 //! `R` with `A = RᵀR`, stored row-major so that every inner loop below runs
 //! along a row (contiguous memory).
+//!
+//! The inner loops are the kernels at the end of this file ([`add_scaled`],
+//! [`sub_scaled`], [`axpby`], [`rotate`], [`add_scaled_rotate`], [`dot`]).
+//! In the wasm build (`simd128`) each has a SIMD128 path, two values per
+//! instruction, chosen by [`mosaic_dsp::simd_enabled`]; it gives
+//! bit-identical results to the scalar path: the same IEEE operations per
+//! element in the same order (no fused multiply-add). [`dot`] sums in four
+//! interleaved partial sums in both paths (element `t` goes to sum `t mod 4`,
+//! then `(s₀ + s₂) + (s₁ + s₃)`, then the tail in order), so that the back
+//! substitution is not one chain of dependent additions; native and wasm
+//! builds round alike. (LLVM vectorises the scalar loops too; the explicit
+//! paths were 4–6 % faster in V8 at p = 256 and 1024.)
 
 /// `R = chol(A + shift·diag(pen))` from the upper triangle of `a` (the
 /// lower one is not read); the lower triangle of `r` is zeroed. Returns
@@ -36,9 +48,7 @@ pub(crate) fn cholesky_upper(a: &[f64], shift: f64, pen: &[f64], r: &mut [f64], 
                 continue;
             }
             let row = &mut tail[(i - k - 1) * p..(i - k) * p];
-            for j in i..p {
-                row[j] -= rki * rk[j];
-            }
+            sub_scaled(&mut row[i..], rki, &rk[i..p]);
         }
     }
     true
@@ -50,26 +60,82 @@ pub(crate) fn cholesky_upper(a: &[f64], shift: f64, pen: &[f64], r: &mut [f64], 
 /// nothing is amplified, and the diagonal only grows (r'_kk = h ≥ r_kk): the
 /// update never fails and stays backward stable however ill-conditioned `A`
 /// is. `u` is overwritten.
-pub(crate) fn cholesky_update(r: &mut [f64], u: &mut [f64], p: usize) {
+///
+/// Also writes `z = R'⁻ᵀu` (p values) in O(p), the forward substitution the
+/// gain `A'⁻¹u = R'⁻¹z` needs: the same rotations applied to the extra
+/// column `[0; 1]` of `[R 0; uᵀ 1]` give `[R' z; 0 γ]`, and since they are
+/// orthogonal, `R'ᵀz = u` (the QR-RLS gain; γ² = 1/(1 + uᵀA⁻¹u)). Rotation k
+/// sets z_k = s·γ and γ ← c·γ, from γ = 1.
+pub(crate) fn cholesky_update(r: &mut [f64], u: &mut [f64], z: &mut [f64], p: usize) {
+    let mut gamma = 1.0;
     for k in 0..p {
         let uk = u[k];
         if uk == 0.0 {
+            z[k] = 0.0;
             continue;
         }
         let row = &mut r[k * p..(k + 1) * p];
-        let rkk = row[k];
-        let mut h = (rkk * rkk + uk * uk).sqrt();
-        if !(h.is_finite() && h > 0.0) {
-            h = rkk.hypot(uk); // only for values beyond 1e154 or below 1e-154
+        let (c, s) = givens(&mut row[k], uk, &mut z[k], &mut gamma);
+        rotate(&mut row[k + 1..], &mut u[k + 1..p], c, s);
+    }
+}
+
+/// The rotation `(c, s)` that zeroes `u_k` against `r_kk`: `r_kk ← h`, and
+/// the extra column's `z_k = s·γ`, `γ ← c·γ` (see [`cholesky_update`]).
+#[inline(always)]
+fn givens(rkk: &mut f64, uk: f64, zk: &mut f64, gamma: &mut f64) -> (f64, f64) {
+    let mut h = (*rkk * *rkk + uk * uk).sqrt();
+    if !(h.is_finite() && h > 0.0) {
+        h = rkk.hypot(uk); // only for values beyond 1e154 or below 1e-154
+    }
+    let c = *rkk / h;
+    let s = uk / h;
+    *rkk = h;
+    *zk = s * *gamma;
+    *gamma *= c;
+    (c, s)
+}
+
+/// [`sym_update`] with β = 1 and [`cholesky_update`] in one pass over the
+/// rows (bit-identical to calling both): row k of the scatter `a` gains
+/// `c·δ_k·δ` and row k of `r` is rotated against `u`, in one loop over the
+/// columns where both apply.
+pub(crate) fn sym_and_cholesky_update(
+    a: &mut [f64],
+    c: f64,
+    delta: &[f64],
+    r: &mut [f64],
+    u: &mut [f64],
+    z: &mut [f64],
+    p: usize,
+) {
+    let mut gamma = 1.0;
+    for k in 0..p {
+        let cu = c * delta[k];
+        let arow = &mut a[k * p + k..(k + 1) * p];
+        let uk = u[k];
+        if uk == 0.0 {
+            z[k] = 0.0;
+            if cu != 0.0 {
+                add_scaled(arow, cu, &delta[k..p]);
+            }
+            continue;
         }
-        let c = rkk / h;
-        let s = uk / h;
-        row[k] = h;
-        for j in k + 1..p {
-            let rj = row[j];
-            let uj = u[j];
-            row[j] = c * rj + s * uj;
-            u[j] = c * uj - s * rj;
+        let row = &mut r[k * p..(k + 1) * p];
+        let (cr, s) = givens(&mut row[k], uk, &mut z[k], &mut gamma);
+        if cu != 0.0 {
+            arow[0] += cu * delta[k];
+            add_scaled_rotate(
+                &mut arow[1..],
+                cu,
+                &delta[k + 1..p],
+                &mut row[k + 1..],
+                &mut u[k + 1..p],
+                cr,
+                s,
+            );
+        } else {
+            rotate(&mut row[k + 1..], &mut u[k + 1..p], cr, s);
         }
     }
 }
@@ -81,22 +147,18 @@ pub(crate) fn solve_rt(r: &[f64], b: &mut [f64], p: usize) {
         let zj = b[j] / row[j];
         b[j] = zj;
         if zj != 0.0 {
-            for k in j + 1..p {
-                b[k] -= row[k] * zj;
-            }
+            sub_scaled(&mut b[j + 1..p], zj, &row[j + 1..]);
         }
     }
 }
 
-/// Solves `Rx = z` in place (back substitution).
+/// Solves `Rx = z` in place (back substitution; each row's sum by [`dot`]).
 pub(crate) fn solve_r(r: &[f64], z: &mut [f64], p: usize) {
+    let z = &mut z[..p];
     for k in (0..p).rev() {
         let row = &r[k * p..(k + 1) * p];
-        let mut s = z[k];
-        for j in k + 1..p {
-            s -= row[j] * z[j];
-        }
-        z[k] = s / row[k];
+        let (head, tail) = z.split_at_mut(k + 1);
+        head[k] = (head[k] - dot(&row[k + 1..], tail)) / row[k];
     }
 }
 
@@ -131,18 +193,261 @@ pub(crate) fn solve_columns(
 pub(crate) fn sym_update(a: &mut [f64], beta: f64, c: f64, u: &[f64], p: usize) {
     for i in 0..p {
         let cu = c * u[i];
-        let row = &mut a[i * p..(i + 1) * p];
+        let row = &mut a[i * p + i..(i + 1) * p];
         if beta == 1.0 {
             if cu != 0.0 {
-                for j in i..p {
-                    row[j] += cu * u[j];
-                }
+                add_scaled(row, cu, &u[i..p]);
             }
         } else {
-            for j in i..p {
-                row[j] = beta * row[j] + cu * u[j];
-            }
+            axpby(row, beta, cu, &u[i..p]);
         }
+    }
+}
+
+/// `y ← y + a·x` (`x` at least as long as `y`).
+#[inline]
+fn add_scaled(y: &mut [f64], a: f64, x: &[f64]) {
+    let x = &x[..y.len()];
+    let done = simd::add_scaled(y, a, x);
+    for (yj, &xj) in y[done..].iter_mut().zip(&x[done..]) {
+        *yj += a * xj;
+    }
+}
+
+/// `y ← y − a·x` (`x` at least as long as `y`).
+#[inline]
+fn sub_scaled(y: &mut [f64], a: f64, x: &[f64]) {
+    let x = &x[..y.len()];
+    let done = simd::sub_scaled(y, a, x);
+    for (yj, &xj) in y[done..].iter_mut().zip(&x[done..]) {
+        *yj -= a * xj;
+    }
+}
+
+/// `y ← b·y + a·x` (`x` at least as long as `y`).
+#[inline]
+fn axpby(y: &mut [f64], b: f64, a: f64, x: &[f64]) {
+    let x = &x[..y.len()];
+    let done = simd::axpby(y, b, a, x);
+    for (yj, &xj) in y[done..].iter_mut().zip(&x[done..]) {
+        *yj = b * *yj + a * xj;
+    }
+}
+
+/// The plane rotation `(x, y) ← (c·x + s·y, c·y − s·x)`, elementwise (`y` at
+/// least as long as `x`).
+#[inline]
+fn rotate(x: &mut [f64], y: &mut [f64], c: f64, s: f64) {
+    let y = &mut y[..x.len()];
+    let done = simd::rotate(x, y, c, s);
+    for (xj, yj) in x[done..].iter_mut().zip(&mut y[done..]) {
+        let (a, b) = (*xj, *yj);
+        *xj = c * a + s * b;
+        *yj = c * b - s * a;
+    }
+}
+
+/// [`add_scaled`]`(y, a, d)` and [`rotate`]`(x, w, c, s)` in one loop (all
+/// of `y`'s length).
+#[inline]
+fn add_scaled_rotate(
+    y: &mut [f64],
+    a: f64,
+    d: &[f64],
+    x: &mut [f64],
+    w: &mut [f64],
+    c: f64,
+    s: f64,
+) {
+    let n = y.len();
+    let (d, x, w) = (&d[..n], &mut x[..n], &mut w[..n]);
+    let done = simd::add_scaled_rotate(y, a, d, x, w, c, s);
+    for j in done..n {
+        y[j] += a * d[j];
+        let (xa, wb) = (x[j], w[j]);
+        x[j] = c * xa + s * wb;
+        w[j] = c * wb - s * xa;
+    }
+}
+
+/// `Σ xⱼyⱼ` (`y` at least as long as `x`) in four interleaved partial sums,
+/// `(s₀ + s₂) + (s₁ + s₃)`, then the `len mod 4` last products in order: the
+/// SIMD path holds s₀, s₁ and s₂, s₃ in two registers and rounds identically.
+#[inline]
+fn dot(x: &[f64], y: &[f64]) -> f64 {
+    let y = &y[..x.len()];
+    let n4 = x.len() - x.len() % 4;
+    let mut t = match simd::dot4(&x[..n4], &y[..n4]) {
+        Some(t) => t,
+        None => {
+            let mut s = [0.0; 4];
+            for (xc, yc) in x[..n4].chunks_exact(4).zip(y[..n4].chunks_exact(4)) {
+                for l in 0..4 {
+                    s[l] += xc[l] * yc[l];
+                }
+            }
+            (s[0] + s[2]) + (s[1] + s[3])
+        }
+    };
+    for (&xj, &yj) in x[n4..].iter().zip(&y[n4..]) {
+        t += xj * yj;
+    }
+    t
+}
+
+/// SIMD128 paths of the kernels (wasm32 with `simd128`, while
+/// [`mosaic_dsp::simd_enabled`]): two values per `f64x2` instruction, the
+/// scalar path's operations per element. Each returns how many leading
+/// values it did (an even number; 0 when disabled), the caller does the rest.
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+mod simd {
+    use core::arch::wasm32::{
+        f64x2, f64x2_add, f64x2_extract_lane, f64x2_mul, f64x2_splat, f64x2_sub, v128,
+    };
+
+    /// `s[0]`, `s[1]` (a `v128.load`).
+    #[inline(always)]
+    fn ld(s: &[f64]) -> v128 {
+        f64x2(s[0], s[1])
+    }
+
+    /// `s[0]`, `s[1]` ← `v` (a `v128.store`).
+    #[inline(always)]
+    fn st(s: &mut [f64], v: v128) {
+        s[0] = f64x2_extract_lane::<0>(v);
+        s[1] = f64x2_extract_lane::<1>(v);
+    }
+
+    /// Applies `f` to the pairs of `y` and `x` (equal lengths); values done.
+    #[inline(always)]
+    fn pairs(y: &mut [f64], x: &[f64], f: impl Fn(v128, v128) -> v128) -> usize {
+        if !mosaic_dsp::simd_enabled() {
+            return 0;
+        }
+        for (yc, xc) in y.chunks_exact_mut(2).zip(x.chunks_exact(2)) {
+            st(yc, f(ld(yc), ld(xc)));
+        }
+        y.len() - y.len() % 2
+    }
+
+    #[inline]
+    pub(super) fn add_scaled(y: &mut [f64], a: f64, x: &[f64]) -> usize {
+        let av = f64x2_splat(a);
+        pairs(y, x, |yv, xv| f64x2_add(yv, f64x2_mul(av, xv)))
+    }
+
+    #[inline]
+    pub(super) fn sub_scaled(y: &mut [f64], a: f64, x: &[f64]) -> usize {
+        let av = f64x2_splat(a);
+        pairs(y, x, |yv, xv| f64x2_sub(yv, f64x2_mul(av, xv)))
+    }
+
+    #[inline]
+    pub(super) fn axpby(y: &mut [f64], b: f64, a: f64, x: &[f64]) -> usize {
+        let (av, bv) = (f64x2_splat(a), f64x2_splat(b));
+        pairs(y, x, |yv, xv| {
+            f64x2_add(f64x2_mul(bv, yv), f64x2_mul(av, xv))
+        })
+    }
+
+    #[inline]
+    pub(super) fn rotate(x: &mut [f64], y: &mut [f64], c: f64, s: f64) -> usize {
+        if !mosaic_dsp::simd_enabled() {
+            return 0;
+        }
+        let (cv, sv) = (f64x2_splat(c), f64x2_splat(s));
+        for (xc, yc) in x.chunks_exact_mut(2).zip(y.chunks_exact_mut(2)) {
+            let (a, b) = (ld(xc), ld(yc));
+            st(xc, f64x2_add(f64x2_mul(cv, a), f64x2_mul(sv, b)));
+            st(yc, f64x2_sub(f64x2_mul(cv, b), f64x2_mul(sv, a)));
+        }
+        x.len() - x.len() % 2
+    }
+
+    #[inline]
+    pub(super) fn add_scaled_rotate(
+        y: &mut [f64],
+        a: f64,
+        d: &[f64],
+        x: &mut [f64],
+        w: &mut [f64],
+        c: f64,
+        s: f64,
+    ) -> usize {
+        if !mosaic_dsp::simd_enabled() {
+            return 0;
+        }
+        let (av, cv, sv) = (f64x2_splat(a), f64x2_splat(c), f64x2_splat(s));
+        for (((yc, dc), xc), wc) in y
+            .chunks_exact_mut(2)
+            .zip(d.chunks_exact(2))
+            .zip(x.chunks_exact_mut(2))
+            .zip(w.chunks_exact_mut(2))
+        {
+            st(yc, f64x2_add(ld(yc), f64x2_mul(av, ld(dc))));
+            let (xa, wb) = (ld(xc), ld(wc));
+            st(xc, f64x2_add(f64x2_mul(cv, xa), f64x2_mul(sv, wb)));
+            st(wc, f64x2_sub(f64x2_mul(cv, wb), f64x2_mul(sv, xa)));
+        }
+        y.len() - y.len() % 2
+    }
+
+    /// The four partial sums of [`super::dot`] over `x`, `y` (lengths a
+    /// multiple of 4), combined; `None` when disabled.
+    #[inline]
+    pub(super) fn dot4(x: &[f64], y: &[f64]) -> Option<f64> {
+        if !mosaic_dsp::simd_enabled() {
+            return None;
+        }
+        let (mut s01, mut s23) = (f64x2_splat(0.0), f64x2_splat(0.0));
+        for (xc, yc) in x.chunks_exact(4).zip(y.chunks_exact(4)) {
+            s01 = f64x2_add(s01, f64x2_mul(ld(&xc[..2]), ld(&yc[..2])));
+            s23 = f64x2_add(s23, f64x2_mul(ld(&xc[2..]), ld(&yc[2..])));
+        }
+        let s = f64x2_add(s01, s23);
+        Some(f64x2_extract_lane::<0>(s) + f64x2_extract_lane::<1>(s))
+    }
+}
+
+/// Builds without SIMD128: every kernel runs its scalar path.
+#[cfg(not(all(target_arch = "wasm32", target_feature = "simd128")))]
+mod simd {
+    #[inline(always)]
+    pub(super) fn add_scaled(_: &mut [f64], _: f64, _: &[f64]) -> usize {
+        0
+    }
+
+    #[inline(always)]
+    pub(super) fn sub_scaled(_: &mut [f64], _: f64, _: &[f64]) -> usize {
+        0
+    }
+
+    #[inline(always)]
+    pub(super) fn axpby(_: &mut [f64], _: f64, _: f64, _: &[f64]) -> usize {
+        0
+    }
+
+    #[inline(always)]
+    pub(super) fn rotate(_: &mut [f64], _: &mut [f64], _: f64, _: f64) -> usize {
+        0
+    }
+
+    #[inline(always)]
+    pub(super) fn add_scaled_rotate(
+        _: &mut [f64],
+        _: f64,
+        _: &[f64],
+        _: &mut [f64],
+        _: &mut [f64],
+        _: f64,
+        _: f64,
+    ) -> usize {
+        0
+    }
+
+    #[inline(always)]
+    pub(super) fn dot4(_: &[f64], _: &[f64]) -> Option<f64> {
+        None
     }
 }
 
@@ -208,8 +513,14 @@ mod tests {
             }
         }
         let mut uu = u.clone();
-        cholesky_update(&mut r, &mut uu, p);
+        let mut z = vec![f64::NAN; p];
+        cholesky_update(&mut r, &mut uu, &mut z, p);
         assert!(max_diff(&rtr(&r, p), &a2) < 1e-12);
+        // z = R'⁻ᵀu: R'ᵀz reproduces u.
+        let rtz: Vec<f64> = (0..p)
+            .map(|i| (0..=i).map(|k| r[k * p + i] * z[k]).sum())
+            .collect();
+        assert!(max_diff(&rtz, &u) < 1e-14);
 
         let b: Vec<f64> = (0..p).map(|i| i as f64 - 2.0).collect();
         let mut x = b.clone();
@@ -218,6 +529,46 @@ mod tests {
             .map(|i| (0..p).map(|j| a2[i * p + j] * x[j]).sum())
             .collect();
         assert!(max_diff(&ax, &b) < 1e-11);
+    }
+
+    #[test]
+    fn fused_update_is_the_two_updates() {
+        let p = 9;
+        let a = spd(p, 7);
+        let mut r = vec![0.0; p * p];
+        assert!(cholesky_upper(&a, 0.5, &[1.0; 9], &mut r, p));
+        // Zeros exercise the rows where only one of the two updates applies.
+        let delta: Vec<f64> = (0..p)
+            .map(|i| {
+                if i % 4 == 2 {
+                    0.0
+                } else {
+                    (i as f64 * 1.3).cos()
+                }
+            })
+            .collect();
+        let c: f64 = 0.75;
+        let sc = c.sqrt();
+        let (mut s1, mut r1) = (a.clone(), r.clone());
+        let mut u1: Vec<f64> = delta.iter().map(|d| sc * d).collect();
+        let mut z1 = vec![f64::NAN; p];
+        sym_update(&mut s1, 1.0, c, &delta, p);
+        cholesky_update(&mut r1, &mut u1, &mut z1, p);
+        let (mut s2, mut r2) = (a.clone(), r.clone());
+        let mut u2: Vec<f64> = delta.iter().map(|d| sc * d).collect();
+        let mut z2 = vec![f64::NAN; p];
+        sym_and_cholesky_update(&mut s2, c, &delta, &mut r2, &mut u2, &mut z2, p);
+        assert_eq!((s1, r1, z1), (s2, r2, z2));
+    }
+
+    #[test]
+    fn dot_sums_in_four_partial_sums() {
+        // Element t goes to partial sum t mod 4, so 1e16 and −1e16 cancel before the 1s are
+        // added (in order, 1e16 + 1 would round back to 1e16); a tail shorter than 4 is in order.
+        let x = [1e16, 1.0, -1e16, 1.0, 1.0, 1.0];
+        let y = [1.0; 6];
+        assert_eq!(dot(&x, &y), 4.0);
+        assert_eq!(dot(&x[..3], &y), 0.0);
     }
 
     #[test]

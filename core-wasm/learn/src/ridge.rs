@@ -439,7 +439,11 @@ impl Ridge {
         self.weight_sum = new;
         self.samples += 1;
         // Normal equations: S ← βS + c·δδᵀ, C ← βC + c·δ·δyᵀ, λ_eff ← βλ_eff.
-        linalg::sym_update(&mut self.s, beta, c, &self.delta, p);
+        // Without forgetting, S's update is done below with R's, in one pass over both.
+        let fused = beta == 1.0 && c > 0.0;
+        if !fused {
+            linalg::sym_update(&mut self.s, beta, c, &self.delta, p);
+        }
         for i in 0..p {
             let cd = c * self.delta[i];
             let row = &mut self.c[i * m..(i + 1) * m];
@@ -461,9 +465,21 @@ impl Ridge {
             for i in 0..p {
                 self.u[i] = sc * self.delta[i];
             }
-            self.k.copy_from_slice(&self.u);
-            linalg::cholesky_update(&mut self.r, &mut self.u, p);
-            linalg::solve(&self.r, &mut self.k, p);
+            // R'ᵀR' = RᵀR + uuᵀ; the gain k = A'⁻¹u = R'⁻¹z, with z = R'⁻ᵀu from the rotations.
+            if fused {
+                linalg::sym_and_cholesky_update(
+                    &mut self.s,
+                    c,
+                    &self.delta,
+                    &mut self.r,
+                    &mut self.u,
+                    &mut self.k,
+                    p,
+                );
+            } else {
+                linalg::cholesky_update(&mut self.r, &mut self.u, &mut self.k, p);
+            }
+            linalg::solve_r(&self.r, &mut self.k, p);
             for o in 0..m {
                 self.e[o] *= sc;
             }
