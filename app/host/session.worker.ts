@@ -30,8 +30,8 @@ import {
 import { logFileName, type LogChannel, type LogSink } from "../engine/runtime/logsink";
 import { RealtimeLoop } from "../engine/runtime/loop";
 import type { Runtime } from "../engine/runtime/runtime";
-import { SabRing } from "../engine/runtime/sab-ring";
-import { EngineSession, type LoopHooks } from "../engine/session";
+import { SabRing, type SabRingInit } from "../engine/runtime/sab-ring";
+import { EngineSession, type LoopHooks, type SessionPlatform } from "../engine/session";
 import { bleProxy } from "../../native-bridges/ble-proxy";
 import { nodeRosBridge } from "../../native-bridges/ros";
 import { serialProxy } from "../../native-bridges/serial-proxy";
@@ -169,39 +169,171 @@ class Loader {
 // ---------------------------------------------------------------------------------------------
 // The session thread.
 
-function runSession(port: MessagePort): void {
-  const post = (m: SessionToHub, transfer?: ArrayBuffer[]): void =>
-    port.postMessage(m, transfer ?? []);
+/** Where `rel` lies: itself when absolute, else inside `baseDir`. */
+function within(baseDir: string, rel: string): string {
+  return isAbsolute(rel) ? rel : resolve(baseDir, rel);
+}
 
-  let session: EngineSession | undefined;
-  let pipelinesDir = process.cwd();
+/** A `Path` log's ring to the host's log writer: about 2^17 values, 4096 frames at least. */
+function allocateLogRing(shape: Shape): SabRingInit {
+  const stride = shape.rows * shape.cols;
+  const capacity = Math.max(4096, Math.ceil((1 << 17) / (stride + 1)));
+  return SabRing.allocate(capacity, stride);
+}
+
+/** A refused load, saying why (`cannot load the pipeline: …` at the file's first line). */
+function loadFailed(file: string, why: string): LoadResult {
+  return {
+    ok: false,
+    spec: undefined,
+    doc: undefined,
+    diagnostics: [
+      {
+        severity: "error",
+        code: "load-failed",
+        message: `cannot load the pipeline: ${why}`,
+        file,
+        line: 1,
+        col: 1,
+      },
+    ],
+  };
+}
+
+/** One error at each block with a `Path` log outside the folders (its first refused output). */
+function pathErrors(
+  spec: NonNullable<LoadResult["spec"]>,
+  baseDir: string,
+  confined: AllowedFolders,
+): Diagnostic[] {
+  const errors: Diagnostic[] = [];
+  for (const b of spec.blocks) {
+    if (b.path === undefined) continue;
+    const outputs = b.outputs.length > 0 ? b.outputs : ["out"];
+    for (const [i, o] of outputs.entries()) {
+      const rel = logFileName(b.path, b.name, o, i === 0);
+      const refused = confined.check(within(baseDir, rel), "write");
+      if (refused === undefined) continue;
+      errors.push({
+        severity: "error",
+        code: "outside-folders",
+        message: `block '${b.name}': Path: ${refused}`,
+        file: spec.file,
+        line: b.pos.line,
+        col: b.pos.col,
+        block: b.name,
+        param: "Path",
+      });
+      break;
+    }
+  }
+  return errors;
+}
+
+/**
+ * The session thread: the hub's messages in, the EngineSession's out. Until `session-init` boots
+ * the session, the UI's messages wait; `confine` sets the folders of the pipelines loaded next;
+ * serial and Bluetooth LE replies go to their proxies.
+ */
+class SessionThread {
+  private session: EngineSession | undefined;
+  private pipelinesDir = process.cwd();
   /** What the pipelines loaded from now on may use (null: anything); see `confine`. */
-  let allowed: AllowedFolders | null = null;
-  const pending: unknown[] = [];
-  const doorbell = new Int32Array(new SharedArrayBuffer(8));
-  let loop: RealtimeLoop | undefined;
-  const serial = serialProxy((m) => post(m));
-  const ble = bleProxy((m) => post(m));
-  const loader = new Loader();
+  private allowed: AllowedFolders | null = null;
+  private readonly pending: unknown[] = [];
+  private readonly doorbell = new Int32Array(new SharedArrayBuffer(8));
+  private loop: RealtimeLoop | undefined;
+  private readonly serial = serialProxy((m) => this.post(m));
+  private readonly ble = bleProxy((m) => this.post(m));
+  private readonly loader = new Loader();
+  private nextLog = 0;
+  /** The files of the loaded pipeline's block modules, polled (see `watchBlocks`). */
+  private watched: string[] = [];
+
+  constructor(private readonly port: MessagePort) {}
+
+  listen(): void {
+    this.port.on("message", (msg: HubToSession) => this.receive(msg));
+  }
+
+  private post(m: SessionToHub, transfer?: ArrayBuffer[]): void {
+    this.port.postMessage(m, transfer ?? []);
+  }
+
+  private receive(msg: HubToSession): void {
+    try {
+      if (msg.type === "session-init") this.boot(msg);
+      else if (msg.type === "confine") {
+        this.allowed = msg.dirs ? new AllowedFolders(msg.dirs) : null;
+      } else if (msg.type === "serial") this.serial.receive(msg);
+      else if (msg.type === "ble") this.ble.receive(msg);
+      else if (this.session) void this.session.handle(msg);
+      else this.pending.push(msg);
+      // The loop turns the event loop only when rung or every 50 ms: answer at once.
+      this.loop?.wake();
+    } catch (e) {
+      this.post({
+        type: "event",
+        event: { t: Date.now() / 1000, level: "error", block: "engine", message: errorMessage(e) },
+      });
+    }
+  }
+
+  private boot(msg: Extract<HubToSession, { type: "session-init" }>): void {
+    this.pipelinesDir = msg.pipelinesDir;
+    initDsp(readFileSync(msg.wasmPath));
+    const session = new EngineSession(catalog, this.platform(msg));
+    this.session = session;
+    this.post({ type: "session-ready", doorbell: this.doorbell.buffer as SharedArrayBuffer });
+    for (const m of this.pending.splice(0)) void session.handle(m);
+  }
+
+  /** What the EngineSession runs on here: files, logs and loads confined, the native bridges. */
+  private platform(msg: Extract<HubToSession, { type: "session-init" }>): SessionPlatform {
+    return {
+      engine: "node host",
+      sharedMemory: true,
+      clock: () => clockFromBase(msg.timeBase) as MonotonicClock,
+      resources: (file) => nodeResources(this.folderOf(file), this.allowed ?? undefined),
+      logs: (file) => this.logSink(file, this.allowed),
+      loadPipeline: (source, file, blocks) => this.parse(source, file, blocks),
+      blockModules: (path) => this.blockModule(path),
+      watchBlocks: (files, changed) => this.watchBlocks(files, changed),
+      recordingFormats: sessionRecordingFormats,
+      // The data folder when there is one, confined as the pipeline is.
+      recordings: (file) =>
+        nodeResources(msg.dataDir ?? this.folderOf(file), this.allowed ?? undefined),
+      io: {
+        udp: nodeUdpBridge(),
+        tcp: nodeTcpBridge(),
+        ros: nodeRosBridge(),
+        serial: this.serial.bridge,
+        ble: this.ble.bridge,
+        python: createPythonBridge(),
+        lsl: nodeLslBridge(),
+      },
+      startLoop: (rt, hooks) => this.startLoop(rt, hooks),
+      post: (m, transfer) => this.post(m, transfer),
+    };
+  }
 
   /** Where a pipeline's relative paths (data, logs) start: its folder. */
-  const folderOf = (file: string): string =>
-    dirname(isAbsolute(file) ? file : resolve(pipelinesDir, file));
+  private folderOf(file: string): string {
+    return dirname(isAbsolute(file) ? file : resolve(this.pipelinesDir, file));
+  }
 
-  let nextLog = 0;
-  function logSink(file: string, confined: AllowedFolders | null): LogSink {
-    const baseDir = folderOf(file);
+  /** `Path` logs of the pipeline `file`, written by the host through a ring each. */
+  private logSink(file: string, confined: AllowedFolders | null): LogSink {
+    const baseDir = this.folderOf(file);
     return {
-      open(block: string, portName: string, isDefaultPort: boolean, path: string, shape: Shape) {
+      open: (block, portName, isDefaultPort, path, shape) => {
         const rel = logFileName(path, block, portName, isDefaultPort);
-        const refused = confined?.check(isAbsolute(rel) ? rel : resolve(baseDir, rel), "write");
+        const refused = confined?.check(within(baseDir, rel), "write");
         if (refused !== undefined) throw new Error(`block '${block}': ${refused}`);
-        const id = nextLog++;
-        const stride = shape.rows * shape.cols;
-        const capacity = Math.max(4096, Math.ceil((1 << 17) / (stride + 1)));
-        const init = SabRing.allocate(capacity, stride);
+        const id = this.nextLog++;
+        const init = allocateLogRing(shape);
         const ring = new SabRing(init);
-        post({
+        this.post({
           type: "log-open",
           id,
           baseDir,
@@ -216,9 +348,9 @@ function runSession(port: MessagePort): void {
           write(f: Frame) {
             ring.write(f, false);
           },
-          close() {
+          close: () => {
             ring.close();
-            post({ type: "log-close", id });
+            this.post({ type: "log-close", id });
           },
         };
         return channel;
@@ -226,156 +358,68 @@ function runSession(port: MessagePort): void {
     };
   }
 
-  /** Every `Path` of a confined pipeline inside its folders: one error at each block that is not. */
-  function checkPaths(r: LoadResult, file: string, confined: AllowedFolders): LoadResult {
-    if (!r.spec) return r;
-    const baseDir = folderOf(file);
-    const errors: Diagnostic[] = [];
-    for (const b of r.spec.blocks) {
-      if (b.path === undefined) continue;
-      const outputs = b.outputs.length > 0 ? b.outputs : ["out"];
-      for (const [i, o] of outputs.entries()) {
-        const rel = logFileName(b.path, b.name, o, i === 0);
-        const refused = confined.check(isAbsolute(rel) ? rel : resolve(baseDir, rel), "write");
-        if (refused === undefined) continue;
-        errors.push({
-          severity: "error",
-          code: "outside-folders",
-          message: `block '${b.name}': Path: ${refused}`,
-          file: r.spec.file,
-          line: b.pos.line,
-          col: b.pos.col,
-          block: b.name,
-          param: "Path",
-        });
-        break;
-      }
-    }
-    if (errors.length === 0) return r;
-    return { ...r, ok: false, spec: undefined, diagnostics: [...r.diagnostics, ...errors] };
-  }
-
   /**
    * Parses and validates `source`: here when small or when it has its own blocks (the loader
    * thread knows only the built-in ones), in the loader thread otherwise.
    */
-  async function parse(source: string, file: string, blocks = catalog): Promise<LoadResult> {
-    const confined = allowed;
+  private async parse(source: string, file: string, blocks = catalog): Promise<LoadResult> {
+    const confined = this.allowed;
     let r: LoadResult | undefined;
     if (source.length > INLINE_CHARS && blocks === catalog) {
-      const got = await loader.load(source, file);
-      if (typeof got === "string") {
-        return {
-          ok: false,
-          spec: undefined,
-          doc: undefined,
-          diagnostics: [
-            {
-              severity: "error",
-              code: "load-failed",
-              message: `cannot load the pipeline: ${got}`,
-              file,
-              line: 1,
-              col: 1,
-            },
-          ],
-        };
-      }
+      const got = await this.loader.load(source, file);
+      if (typeof got === "string") return loadFailed(file, got);
       if (got) r = fromPortable(got);
     }
     r ??= loadPipeline(source, file, blocks);
-    return confined ? checkPaths(r, file, confined) : r;
+    return confined ? this.checkPaths(r, file, confined) : r;
+  }
+
+  /** Every `Path` of a confined pipeline inside its folders: one error at each block that is not. */
+  private checkPaths(r: LoadResult, file: string, confined: AllowedFolders): LoadResult {
+    if (!r.spec) return r;
+    const errors = pathErrors(r.spec, this.folderOf(file), confined);
+    if (errors.length === 0) return r;
+    return { ...r, ok: false, spec: undefined, diagnostics: [...r.diagnostics, ...errors] };
   }
 
   /** A user's block module, when the pipeline may run code from where it is (confinement). */
-  function blockModule(path: string): Promise<ModuleLoadResult> {
-    const confined = allowed;
+  private blockModule(path: string): Promise<ModuleLoadResult> {
+    const confined = this.allowed;
     return loadBlockModule(path, confined ? (f) => confined.check(f, "run code from") : undefined);
   }
 
-  /** The files of the loaded pipeline's block modules, polled (an editor may save by renaming). */
-  let watched: string[] = [];
-  function watchBlocks(files: string[], changed: (file: string) => void): void {
-    for (const f of watched) unwatchFile(f);
-    watched = files;
-    let pending: NodeJS.Timeout | undefined;
+  /** Polls the block modules' files (an editor may save by renaming), replacing the last ones. */
+  private watchBlocks(files: string[], changed: (file: string) => void): void {
+    for (const f of this.watched) unwatchFile(f);
+    this.watched = files;
+    let reload: NodeJS.Timeout | undefined;
     for (const f of files) {
       watchFile(f, { interval: 250, persistent: false }, (now, before) => {
         if (now.mtimeMs === before.mtimeMs && now.size === before.size) return;
         // One reload for a save that touches the file several times.
-        clearTimeout(pending);
-        pending = setTimeout(() => changed(f), 150);
+        clearTimeout(reload);
+        reload = setTimeout(() => changed(f), 150);
       });
     }
   }
 
-  const yieldNow = (fn: () => void): void => void setImmediate(fn);
-
-  function startLoop(rt: Runtime, hooks: LoopHooks) {
-    loop = new RealtimeLoop({
+  private startLoop(rt: Runtime, hooks: LoopHooks): RealtimeLoop {
+    const loop = new RealtimeLoop({
       runtime: rt,
-      yieldNow,
+      yieldNow: (fn: () => void): void => void setImmediate(fn),
       clock: rt.clock,
-      doorbell,
+      doorbell: this.doorbell,
       precision: false,
       ...hooks,
     });
+    this.loop = loop;
     loop.start();
     return loop;
   }
-
-  function boot(msg: Extract<HubToSession, { type: "session-init" }>): void {
-    pipelinesDir = msg.pipelinesDir;
-    initDsp(readFileSync(msg.wasmPath));
-    session = new EngineSession(catalog, {
-      engine: "node host",
-      sharedMemory: true,
-      clock: () => clockFromBase(msg.timeBase) as MonotonicClock,
-      resources: (file) => nodeResources(folderOf(file), allowed ?? undefined),
-      logs: (file) => logSink(file, allowed),
-      loadPipeline: parse,
-      blockModules: blockModule,
-      watchBlocks,
-      recordingFormats: sessionRecordingFormats,
-      // The data folder when there is one, confined as the pipeline is.
-      recordings: (file) => nodeResources(msg.dataDir ?? folderOf(file), allowed ?? undefined),
-      io: {
-        udp: nodeUdpBridge(),
-        tcp: nodeTcpBridge(),
-        ros: nodeRosBridge(),
-        serial: serial.bridge,
-        ble: ble.bridge,
-        python: createPythonBridge(),
-        lsl: nodeLslBridge(),
-      },
-      startLoop,
-      post: (m, transfer) => post(m, transfer),
-    });
-    post({ type: "session-ready", doorbell: doorbell.buffer as SharedArrayBuffer });
-    for (const m of pending.splice(0)) void session.handle(m);
-  }
-
-  port.on("message", (msg: HubToSession) => {
-    try {
-      if (msg.type === "session-init") boot(msg);
-      else if (msg.type === "confine") allowed = msg.dirs ? new AllowedFolders(msg.dirs) : null;
-      else if (msg.type === "serial") serial.receive(msg);
-      else if (msg.type === "ble") ble.receive(msg);
-      else if (session) void session.handle(msg);
-      else pending.push(msg);
-      // The loop turns the event loop only when rung or every 50 ms: answer at once.
-      loop?.wake();
-    } catch (e) {
-      post({
-        type: "event",
-        event: { t: Date.now() / 1000, level: "error", block: "engine", message: errorMessage(e) },
-      });
-    }
-  });
 }
 
 // Last: the functions and classes above exist by now.
 const port = parentPort;
 if (!port) throw new Error("session.worker must run in a worker thread");
 if ((workerData as { role?: string } | null)?.role === "loader") runLoader(port);
-else runSession(port);
+else new SessionThread(port).listen();
