@@ -53,10 +53,7 @@ export interface RowSource {
   pairsIn: SignalInput | null;
   /** MOSAIC's form: the Buffer named in the params, read when the model is built. */
   named: string | undefined;
-  /**
-   * Values per row kept: d plus the outputs known before the File is read (from the pairs input
-   * or Outputs; none when only the File says how many).
-   */
+  /** Values per row kept: d data values plus the M targets (from the pairs input, Outputs or the File). */
   width: number;
 }
 
@@ -70,7 +67,6 @@ export async function openBatch(ctx: BlockContext, p: BatchParams): Promise<Batc
   const pairsIn = ctx.inputs.length > 1 ? signalInput(ctx, 1) : null;
   const named = namedBuffer(ctx, p, pairsIn);
   const outputs = pairsIn ? pairsOutputs(p, feat, pairsIn) : (p.Outputs ?? null);
-  const rows: RowSource = { pairsIn, named, width: feat.size + (outputs ?? 0) };
   const startup = await readStartupModel(ctx, p.File, {
     inputs: feat.size,
     outputs,
@@ -85,6 +81,8 @@ export async function openBatch(ctx: BlockContext, p: BatchParams): Promise<Batc
       "Outputs",
     );
   }
+  // A row is [target…, data…]: its width is known once the File has said how many targets.
+  const rows: RowSource = { pairsIn, named, width: feat.size + M };
   if (pairsIn || named !== undefined) checkMaxRows(p.MaxRows, rows.width);
   return new BatchRun(ctx, p, feat, rows, M, startup);
 }

@@ -243,6 +243,34 @@ P: { Type: BatchPredictor, Inputs: [F], Params: { Buffer: store, Model: ridge, O
     expect(manual.invoke("P", "inspect")).toMatch(/fitted on 0 rows/);
     expect(manual.invoke("P", "train")).toMatch(/fitted ridge .* on 49 rows/);
     manual.dispose();
+    // With a File and no Outputs the rows' width comes from the model read from the File.
+    const files: Record<string, string> = {};
+    const withFile = async (outputs: string) => {
+      const y = yaml("").replace("Outputs: 1", `${outputs}File: m.json, AutoTrain: false`);
+      const clock = new VirtualClock(0);
+      const created = await Runtime.create({
+        spec: loadPipeline(y, "p.yaml", catalog).spec!,
+        catalog,
+        clock,
+        virtual: true,
+        resources: memoryResources(files),
+      });
+      expect(created.diagnostics).toEqual([]);
+      const rt = created.runtime!;
+      rt.start();
+      runVirtual(rt, clock, 4);
+      return rt;
+    };
+    const first = await withFile("Outputs: 1, ");
+    const fitted = first.invoke("P", "train");
+    expect(fitted).toMatch(/fitted ridge .* on 49 rows, in-sample R² 0\.\d+$/);
+    first.invoke("P", "save", "m.json");
+    await new Promise((r) => setTimeout(r, 0));
+    first.dispose();
+    const second = await withFile("");
+    // The same rows, aligned as the first run's: the same fit.
+    expect(second.invoke("P", "train")).toBe(fitted);
+    second.dispose();
     const lone = await runVirtualPipeline(
       "T: { Type: ScheduledTimer, DesiredRate: 25 }\n" +
         "F: { Type: SinGenerator, Inputs: [T], Params: { Components: 2 } }\n" +
