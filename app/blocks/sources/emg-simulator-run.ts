@@ -124,7 +124,6 @@ export class SimulatorRun {
     this.channels = p.Channels;
     const gestures = new GestureSet(p);
     this.gestures = gestures;
-    this.synth = createSynth(p, rate);
     [this.emg, this.oneHot] = declareOutputs(ctx, this.channels, gestures.names);
     const cueMap = Int32Array.from(p.CueGestures ?? gestures.names, (n) => gestures.indexOf(n));
     this.following = checkCueInputs(ctx, gestures, cueMap, p.CueGestures) > 0;
@@ -141,6 +140,8 @@ export class SimulatorRun {
     this.seq =
       p.Sequence !== undefined ? new GestureSequence(p.Sequence, gestures, ctx) : undefined;
     this.initialGesture = gestures.indexOf(p.Gesture);
+    // Last, once every param has been checked: a refused block leaves no generator behind.
+    this.synth = createSynth(p, rate);
     this.restart();
   }
 
