@@ -14,28 +14,10 @@ import {
   launchChromium,
   openApp,
   serveApp,
+  servedUrl,
   type Chromium,
   type Served,
 } from "./harness";
-
-/** Starts `mosaic serve` on a free port; resolves with the URL it printed. */
-function startServe(): Promise<{ cli: ChildProcess; url: string }> {
-  const cli = startCli(["serve", "pipelines/demo.yaml", "--port", "0"]);
-  let out = "";
-  return new Promise((resolve, reject) => {
-    const t = setTimeout(() => reject(new Error(`no URL printed: ${out}`)), 20_000);
-    const seen = (d: Buffer): void => {
-      out += d.toString();
-      const m = /MOSAIC is at (\S+)/.exec(out);
-      if (m) {
-        clearTimeout(t);
-        resolve({ cli, url: m[1]! });
-      }
-    };
-    cli.stdout!.on("data", seen);
-    cli.stderr!.on("data", (d: Buffer) => (out += d.toString()));
-  });
-}
 
 /** The toolbar's engine label once it names one ("" while none). */
 const ENGINE_LABEL = `(document.querySelector("header .engine-where")?.textContent ?? "")`;
@@ -49,9 +31,8 @@ describe.skipIf(!haveChromium)("the page names its engine and a refusal's cause"
   beforeAll(async () => {
     ensureWebBuild();
     requireBuild();
-    const s = await startServe();
-    cli = s.cli;
-    url = new URL(s.url);
+    cli = startCli(["serve", "pipelines/demo.yaml", "--port", "0"]);
+    url = new URL(await servedUrl(cli, 20_000));
     browser = await launchChromium();
   }, 60_000);
 

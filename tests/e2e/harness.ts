@@ -181,19 +181,48 @@ export async function statuses(page: Page): Promise<Record<string, string>> {
   );
 }
 
-/** The URL `mosaic serve` prints ("MOSAIC is at URL"); rejects with what it printed after `ms`. */
-export function servedUrl(cli: ChildProcess, ms = 30_000): Promise<string> {
-  let out = "";
+/**
+ * The first whole line `child` prints on stdout that matches `re`. Rejects, with what it printed
+ * on stdout and stderr, when it ends first or after `ms`.
+ */
+export function printedLine(child: ChildProcess, re: RegExp, ms: number): Promise<string> {
+  let printed = "";
+  let stdout = "";
+  let done = false;
   return new Promise<string>((resolve, reject) => {
-    const t = setTimeout(() => reject(new Error(`no URL printed: ${out}`)), ms);
-    cli.stdout!.on("data", (d: Buffer) => {
-      out += d.toString();
-      const m = /MOSAIC is at (\S+)/.exec(out);
-      if (m) {
-        clearTimeout(t);
-        resolve(m[1]!);
-      }
+    const fail = (why: string): void => {
+      if (done) return;
+      done = true;
+      clearTimeout(t);
+      reject(new Error(`${why}: ${printed}`));
+    };
+    const t = setTimeout(() => fail(`no line matching ${re} in ${ms} ms`), ms);
+    child.stdout!.on("data", (d: Buffer) => {
+      if (done) return;
+      printed += d.toString();
+      stdout += d.toString();
+      const line = stdout
+        .split("\n")
+        .slice(0, -1)
+        .find((l) => re.test(l));
+      if (line === undefined) return;
+      done = true;
+      clearTimeout(t);
+      resolve(line);
     });
-    cli.stderr!.on("data", (d: Buffer) => (out += d.toString()));
+    child.stderr!.on("data", (d: Buffer) => {
+      if (!done) printed += d.toString();
+    });
+    child.once("close", (code) => fail(`ended (exit code ${code}) before printing ${re}`));
   });
+}
+
+const SERVED_AT = /MOSAIC is at (\S+)/;
+
+/**
+ * The URL `mosaic serve` prints ("MOSAIC is at URL"); rejects with what it printed if it ends
+ * first or after `ms`.
+ */
+export async function servedUrl(cli: ChildProcess, ms = 30_000): Promise<string> {
+  return SERVED_AT.exec(await printedLine(cli, SERVED_AT, ms))![1]!;
 }

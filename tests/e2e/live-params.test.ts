@@ -19,6 +19,7 @@ import {
   openApp,
   ROOT,
   serveApp,
+  servedUrl,
   type AppPage,
   type Chromium,
 } from "./harness";
@@ -27,25 +28,6 @@ const PANEL = '[data-panel="Amplification"]';
 const VALUE = `${PANEL} [data-param="Value"]`;
 const NODE_MARK = '.block-node[data-block="Amplification"] .block-node__changed';
 const DEMO = readFileSync(join(ROOT, "pipelines/demo.yaml"), "utf8");
-
-async function serve(): Promise<{ cli: ChildProcess; url: string }> {
-  const cli = startCli(["serve", "pipelines/demo.yaml", "--port", "0"]);
-  let out = "";
-  const url = await new Promise<string>((resolve, reject) => {
-    const t = setTimeout(() => reject(new Error(`no URL printed: ${out}`)), 30_000);
-    const seen = (d: Buffer) => {
-      out += d.toString();
-      const m = /MOSAIC is at (\S+)/.exec(out);
-      if (m) {
-        clearTimeout(t);
-        resolve(m[1]!);
-      }
-    };
-    cli.stdout!.on("data", seen);
-    cli.stderr!.on("data", (d: Buffer) => (out += d.toString()));
-  });
-  return { cli, url };
-}
 
 /** Waits (generously: the machine may be loaded) until the page shows the running demo. */
 async function running(page: Page): Promise<void> {
@@ -100,7 +82,8 @@ describe.skipIf(!haveChromium)("live params on mosaic serve (two tabs)", () => {
   beforeAll(async () => {
     ensureWebBuild();
     requireBuild();
-    ({ cli, url } = await serve());
+    cli = startCli(["serve", "pipelines/demo.yaml", "--port", "0"]);
+    url = await servedUrl(cli, 30_000);
     browser = await launchChromium();
     a = await openApp(browser, url, undefined, { waitRunning: false });
     b = await openApp(browser, url, undefined, { waitRunning: false });

@@ -17,6 +17,7 @@ import {
   launchChromium,
   openApp,
   serveApp,
+  servedUrl,
   type Chromium,
   type Served,
 } from "./harness";
@@ -179,19 +180,7 @@ describe.skipIf(!haveChromium)("saved panel layouts with mosaic serve (Chromium)
     ensureWebBuild();
     requireBuild();
     cli = startCli(["serve", "pipelines/demo.yaml", "--port", "0"]);
-    let out = "";
-    url = await new Promise<string>((resolve, reject) => {
-      const t = setTimeout(() => reject(new Error(`no URL printed: ${out}`)), 30_000);
-      cli.stdout!.on("data", (d: Buffer) => {
-        out += d.toString();
-        const m = /MOSAIC is at (\S+)/.exec(out);
-        if (m) {
-          clearTimeout(t);
-          resolve(m[1]!);
-        }
-      });
-      cli.stderr!.on("data", (d: Buffer) => (out += d.toString()));
-    });
+    url = await servedUrl(cli, 30_000);
     chromium = await launchChromium();
   }, 90_000);
 

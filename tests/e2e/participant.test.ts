@@ -20,6 +20,7 @@ import {
   launchChromium,
   openApp,
   serveApp,
+  servedUrl,
   type AppPage,
   type Chromium,
   type Served,
@@ -211,19 +212,7 @@ describe.skipIf(!haveChromium)("participant window", () => {
     beforeAll(async () => {
       requireBuild();
       cli = startCli(["serve", FIXTURE, "--port", "0"]);
-      let out = "";
-      url = await new Promise<string>((resolve, reject) => {
-        const t = setTimeout(() => reject(new Error(`no URL printed: ${out}`)), 30_000);
-        cli.stdout!.on("data", (d: Buffer) => {
-          out += d.toString();
-          const m = /MOSAIC is at (\S+)/.exec(out);
-          if (m) {
-            clearTimeout(t);
-            resolve(m[1]!);
-          }
-        });
-        cli.stderr!.on("data", (d: Buffer) => (out += d.toString()));
-      });
+      url = await servedUrl(cli, 30_000);
     }, 60_000);
 
     afterAll(async () => {

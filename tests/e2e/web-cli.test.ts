@@ -10,7 +10,7 @@ import { createServer } from "node:net";
 import { join } from "node:path";
 import { afterEach, describe, expect, test } from "vitest";
 import { serveStatic } from "../../app/host/web-server";
-import { ROOT, WEB, ensureWebBuild } from "./harness";
+import { ROOT, WEB, ensureWebBuild, printedLine } from "./harness";
 
 const CLI = join(ROOT, "dist/cli.mjs");
 
@@ -23,28 +23,6 @@ function freePort(): Promise<number> {
       const a = s.address();
       const port = typeof a === "object" && a ? a.port : 0;
       s.close(() => resolve(port));
-    });
-  });
-}
-
-/** Resolves with the first stdout line matching `re` (rejects on exit or after `ms`). */
-function waitLine(child: ChildProcess, re: RegExp, ms = 15_000): Promise<string> {
-  return new Promise((resolve, reject) => {
-    let buf = "";
-    let errs = "";
-    const timer = setTimeout(() => reject(new Error(`no line matching ${re} in ${ms} ms`)), ms);
-    child.stdout!.on("data", (d: Buffer) => {
-      buf += d.toString();
-      const m = buf.split("\n").find((l) => re.test(l));
-      if (m !== undefined) {
-        clearTimeout(timer);
-        resolve(m);
-      }
-    });
-    child.stderr!.on("data", (d: Buffer) => (errs += d.toString()));
-    child.once("exit", (code) => {
-      clearTimeout(timer);
-      reject(new Error(`exited with ${code} before printing ${re}: ${errs}${buf}`));
     });
   });
 }
@@ -70,7 +48,7 @@ describe.skipIf(!existsSync(CLI))("mosaic web", () => {
       stdio: ["ignore", "pipe", "pipe"],
       env: { ...process.env, NO_COLOR: "1" },
     });
-    const line = await waitLine(child, /MOSAIC is at /);
+    const line = await printedLine(child, /MOSAIC is at /, 15_000);
     expect(line).toBe(`MOSAIC is at http://127.0.0.1:${port}/`);
 
     const page = await fetch(`http://127.0.0.1:${port}/`);
