@@ -49,17 +49,20 @@ async function telemetryStatuses(page: Page, block: string, n: number): Promise<
 const EMG = Array.from({ length: 8 }, (_, k) => `EMG ${k + 1}`);
 const SCOPE = '[data-panel="Emg"] [data-view="scope"]';
 
-/** The CSV export of a panel's scope, parsed: header and rows of numbers. */
-async function exportCsv(
-  page: Page,
-  scope = SCOPE,
-): Promise<{ header: string[]; rows: number[][] }> {
-  const [download] = await Promise.all([
+/** Clicks the Emg scope's export `button`: the file it downloads, its name and its bytes. */
+async function download(page: Page, button: string): Promise<{ name: string; data: Buffer }> {
+  const [file] = await Promise.all([
     page.waitForEvent("download"),
-    page.click(`${scope} button:has-text("CSV")`),
+    page.click(`${SCOPE} button:has-text("${button}")`),
   ]);
-  expect(download.suggestedFilename()).toMatch(/^Emg\.emg-.*\.csv$/);
-  const text = readFileSync((await download.path())!, "utf8");
+  return { name: file.suggestedFilename(), data: readFileSync((await file.path())!) };
+}
+
+/** The CSV export of the Emg scope, parsed: header and rows of numbers. */
+async function exportCsv(page: Page): Promise<{ header: string[]; rows: number[][] }> {
+  const csv = await download(page, "CSV");
+  expect(csv.name).toMatch(/^Emg\.emg-.*\.csv$/);
+  const text = csv.data.toString("utf8");
   const [head, ...lines] = text.trimEnd().split("\n");
   return {
     header: head!.split(","),
@@ -201,6 +204,30 @@ async function plotArea(
   return box!;
 }
 
+/** Pauses the Emg scope and waits until its footer says it is paused. */
+async function pause(page: Page): Promise<void> {
+  await page.click(`${SCOPE} button:has-text("Pause")`);
+  await page.waitForSelector(`${SCOPE} .mp-foot:has-text("paused")`);
+}
+
+/** The texts of the elements `sel`, in the page's order. */
+function texts(page: Page, sel: string): Promise<string[]> {
+  return page.locator(sel).allTextContents();
+}
+
+/** The Emg scope's cursor readout: "t = … s", then a line per channel ("EMG 1: … mV"). */
+function readoutLines(page: Page): Promise<string[]> {
+  return texts(page, `${SCOPE} .mp-readout div`);
+}
+
+/** Drags the mouse from (x, y) by `dx` pixels across, in `steps` moves. */
+async function drag(page: Page, x: number, y: number, dx: number, steps: number): Promise<void> {
+  await page.mouse.move(x, y);
+  await page.mouse.down();
+  await page.mouse.move(x + dx, y, { steps });
+  await page.mouse.up();
+}
+
 describe.skipIf(!haveChromium)("scopes and panel views (browser build, Chromium)", () => {
   let served: Served;
   let chromium: Chromium;
@@ -215,10 +242,40 @@ describe.skipIf(!haveChromium)("scopes and panel views (browser build, Chromium)
     await served?.close();
   });
 
-  test("a Buffer that records (and emits nothing) is not idle while it writes rows", async () => {
-    const app = await open(chromium, served.url, "e2e/recorder-status.yaml");
-    const { page } = app;
-    try {
+  type Check = (page: Page) => Promise<void>;
+
+  /**
+   * A test on a new page of the app on `pipeline` (default: the demo): `check` runs on the page,
+   * then the page must have reported no errors. The page is closed after, leaving a screenshot of
+   * how it ended in artifacts/ (scopes-<part of the test's name>.png: what a failed test left).
+   */
+  function testOnPage(name: string, check: Check): void;
+  function testOnPage(name: string, pipeline: string, check: Check): void;
+  function testOnPage(name: string, a: string | Check, b?: Check): void {
+    const [pipeline, check] = typeof a === "string" ? [a, b!] : [undefined, a];
+    test(
+      name,
+      async () => {
+        const app = await open(chromium, served.url, pipeline);
+        try {
+          await check(app.page);
+          expect(app.errors.join("\n")).toBe("");
+        } finally {
+          const shot = expect.getState().currentTestName?.slice(52, 70).replace(/\W+/g, "-");
+          await app.page
+            .screenshot({ path: artifact(`scopes-${shot}.png`) })
+            .catch(() => undefined);
+          await app.close();
+        }
+      },
+      180_000,
+    );
+  }
+
+  testOnPage(
+    "a Buffer that records (and emits nothing) is not idle while it writes rows",
+    "e2e/recorder-status.yaml",
+    async (page) => {
       const node = '.block-node[data-block="Recorder"]';
       // Its status text says it records (the capture phase lasts 10 minutes).
       await page.click(node);
@@ -229,79 +286,52 @@ describe.skipIf(!haveChromium)("scopes and panel views (browser build, Chromium)
       expect(seen.filter((s) => s === "idle")).toEqual([]);
       expect(await page.getAttribute(node, "data-status")).toBe("ontime");
       await page.screenshot({ path: artifact("recorder-status.png") });
-      expect(app.errors.join("\n")).toBe("");
-    } finally {
-      await app.page
-        .screenshot({
-          path: artifact(
-            `scopes-${expect.getState().currentTestName?.slice(52, 70).replace(/\W+/g, "-")}.png`,
-          ),
-        })
-        .catch(() => undefined);
-      await app.close();
-    }
-  }, 180_000);
+    },
+  );
 
-  test("channels and outputs are named: EMG 1…8 and the gestures in legends, picker and labels", async () => {
-    const app = await open(chromium, served.url, "pipelines/examples/training.yaml");
-    const { page } = app;
-    try {
-      const legend = (panel: string) =>
-        page.locator(`[data-panel="${panel}"] .mp-legend .mp-chip`).allTextContents();
+  testOnPage(
+    "channels and outputs are named: EMG 1…8 and the gestures in legends, picker and labels",
+    "pipelines/examples/training.yaml",
+    async (page) => {
+      const legend = (panel: string) => texts(page, `[data-panel="${panel}"] .mp-legend .mp-chip`);
       await openPanel(page, "Myo");
       await page.waitForSelector('[data-panel="Myo"] .mp-legend .mp-chip');
-      expect(await legend("Myo")).toEqual(Array.from({ length: 8 }, (_, k) => `EMG ${k + 1}`));
+      expect(await legend("Myo")).toEqual(EMG);
       // The channel picker's toggles.
       await page.click('[data-panel="Myo"] .mp-picker > button');
-      expect(await page.locator('[data-panel="Myo"] .mp-toggles label').allTextContents()).toEqual(
-        Array.from({ length: 8 }, (_, k) => `EMG ${k + 1}`),
-      );
+      expect(await texts(page, '[data-panel="Myo"] .mp-toggles label')).toEqual(EMG);
 
       const gestures = ["fist", "open", "pinch", "flexion", "extension"];
+      const predictor = '[data-panel="Predictor"]';
+      const showTab = (tab: string) => page.click(`${predictor} [data-tab="${tab}"]`);
       await openPanel(page, "Predictor");
-      await page.click('[data-panel="Predictor"] [data-tab="scope"]');
-      await page.waitForSelector('[data-panel="Predictor"] .mp-legend .mp-chip');
+      await showTab("scope");
+      await page.waitForSelector(`${predictor} .mp-legend .mp-chip`);
       expect(await legend("Predictor")).toEqual(gestures);
       // The spider's spokes and the label view.
-      await page.click('[data-panel="Predictor"] [data-tab="spider"]');
-      await page.waitForSelector('[data-panel="Predictor"] [data-view="spider"]');
+      await showTab("spider");
+      await page.waitForSelector(`${predictor} [data-view="spider"]`);
       const spider = await page.getAttribute(
-        '[data-panel="Predictor"] [data-view="spider"] canvas',
+        `${predictor} [data-view="spider"] canvas`,
         "aria-label",
       );
       for (const g of gestures) expect(spider).toContain(g);
-      await page.click('[data-panel="Predictor"] [data-tab="label"]');
-      await page.waitForSelector('[data-panel="Predictor"] [data-view="label"] dt');
-      const dts = await page
-        .locator('[data-panel="Predictor"] section[aria-label="Output prediction"] dt')
-        .allTextContents();
+      await showTab("label");
+      await page.waitForSelector(`${predictor} [data-view="label"] dt`);
+      const dts = await texts(page, `${predictor} section[aria-label="Output prediction"] dt`);
       expect(dts).toEqual(gestures);
       // The fit output sends values once the first capture trains the model (about 3 s in).
-      await page.waitForSelector('[data-panel="Predictor"] section[aria-label="Output fit"] dt', {
-        timeout: 60_000,
-      });
-      const fit = await page
-        .locator('[data-panel="Predictor"] section[aria-label="Output fit"] dt')
-        .allTextContents();
+      const fitNames = `${predictor} section[aria-label="Output fit"] dt`;
+      await page.waitForSelector(fitNames, { timeout: 60_000 });
+      const fit = await texts(page, fitNames);
       expect(fit).toEqual(["samples", ...gestures.map((g) => `R² ${g}`)]);
       await page.screenshot({ path: artifact("names-training.png") });
-      expect(app.errors.join("\n")).toBe("");
-    } finally {
-      await app.page
-        .screenshot({
-          path: artifact(
-            `scopes-${expect.getState().currentTestName?.slice(52, 70).replace(/\W+/g, "-")}.png`,
-          ),
-        })
-        .catch(() => undefined);
-      await app.close();
-    }
-  }, 180_000);
+    },
+  );
 
-  test("pause holds the picture; wheel zooms time and amplitude, drag pans, the readout names each value", async () => {
-    const app = await open(chromium, served.url);
-    const { page } = app;
-    try {
+  testOnPage(
+    "pause holds the picture; wheel zooms time and amplitude, drag pans, the readout names each value",
+    async (page) => {
       await page.keyboard.press("2"); // fist: a strong signal
       await openEmgScope(page);
       const area = await plotArea(page);
@@ -310,16 +340,14 @@ describe.skipIf(!haveChromium)("scopes and panel views (browser build, Chromium)
 
       // The readout: the time and every channel's value, named, with the unit.
       await page.mouse.move(cx, cy);
-      const readout = page.locator(`${SCOPE} .mp-readout`);
-      await readout.waitFor();
-      const live = await readout.locator("div").allTextContents();
+      await page.locator(`${SCOPE} .mp-readout`).waitFor();
+      const live = await readoutLines(page);
       expect(live[0]).toMatch(/^t = \d+\.\d{3} s$/);
       expect(live.slice(1).map((l) => l.split(":")[0])).toEqual(EMG);
       expect(live.slice(1).every((l) => / mV$/.test(l))).toBe(true);
 
       // Pause: the picture holds (two looks a few frames apart are the same).
-      await page.click(`${SCOPE} button:has-text("Pause")`);
-      await page.waitForSelector(`${SCOPE} .mp-foot:has-text("paused")`);
+      await pause(page);
       const plot = page.locator(`${SCOPE} .mp-plot`);
       const a = await plot.screenshot();
       await frames(page, 3);
@@ -333,11 +361,13 @@ describe.skipIf(!haveChromium)("scopes and panel views (browser build, Chromium)
       await page.waitForFunction(
         (sel) =>
           !(
-            globalThis as unknown as { document: { querySelector(q: string): { hidden: boolean } } }
+            globalThis as unknown as {
+              document: { querySelector(q: string): { hidden: boolean } };
+            }
           ).document.querySelector(sel).hidden,
         `${SCOPE} .mp-readout`,
       );
-      const lines = await readout.locator("div").allTextContents();
+      const lines = await readoutLines(page);
       const t = Number(/t = ([\d.]+) s/.exec(lines[0]!)![1]);
       const row = whole.rows.reduce((best, r) =>
         Math.abs(r[0]! - t) < Math.abs(best[0]! - t) ? r : best,
@@ -364,10 +394,7 @@ describe.skipIf(!haveChromium)("scopes and panel views (browser build, Chromium)
       expect(Math.abs(mid(zoomed.rows) - mid(whole.rows))).toBeLessThan(0.05);
 
       // Drag to the right by a quarter of the plot: the view goes back a quarter of its span.
-      await page.mouse.move(cx, cy);
-      await page.mouse.down();
-      await page.mouse.move(cx + area.width / 4, cy, { steps: 5 });
-      await page.mouse.up();
+      await drag(page, cx, cy, area.width / 4, 5);
       const panned = await exportCsv(page);
       const back =
         zoomed.rows[zoomed.rows.length - 1]![0]! - panned.rows[panned.rows.length - 1]![0]!;
@@ -397,26 +424,14 @@ describe.skipIf(!haveChromium)("scopes and panel views (browser build, Chromium)
       // Resume: it follows the data again.
       await page.click(`${SCOPE} button:has-text("Resume")`);
       await page.waitForSelector(`${SCOPE} .mp-foot:has-text("events/s")`, { timeout: 60_000 });
-      expect(app.errors.join("\n")).toBe("");
-    } finally {
-      await app.page
-        .screenshot({
-          path: artifact(
-            `scopes-${expect.getState().currentTestName?.slice(52, 70).replace(/\W+/g, "-")}.png`,
-          ),
-        })
-        .catch(() => undefined);
-      await app.close();
-    }
-  }, 180_000);
+    },
+  );
 
-  test("CSV export: the header names the channels, the rows are the visible window", async () => {
-    const app = await open(chromium, served.url);
-    const { page } = app;
-    try {
+  testOnPage(
+    "CSV export: the header names the channels, the rows are the visible window",
+    async (page) => {
       await openEmgScope(page);
-      await page.click(`${SCOPE} button:has-text("Pause")`);
-      await page.waitForSelector(`${SCOPE} .mp-foot:has-text("paused")`);
+      await pause(page);
       const { header, rows } = await exportCsv(page);
       expect(header).toEqual(["time_s", ...EMG]);
       // 5 s at 200 Hz: about 1000 rows, in time order, every value a number.
@@ -425,115 +440,73 @@ describe.skipIf(!haveChromium)("scopes and panel views (browser build, Chromium)
       for (let i = 1; i < rows.length; i++) expect(rows[i]![0]!).toBeGreaterThan(rows[i - 1]![0]!);
       expect(rows.every((r) => r.length === 9 && r.every(Number.isFinite))).toBe(true);
       expect(sampleRate(rows.map((r) => r[0]!))).toBeCloseTo(200, 0);
-      expect(app.errors.join("\n")).toBe("");
-    } finally {
-      await app.page
-        .screenshot({
-          path: artifact(
-            `scopes-${expect.getState().currentTestName?.slice(52, 70).replace(/\W+/g, "-")}.png`,
-          ),
-        })
-        .catch(() => undefined);
-      await app.close();
-    }
-  }, 180_000);
+    },
+  );
 
-  test("PNG export is a valid PNG of the plot with its legend", async () => {
-    const app = await open(chromium, served.url);
-    const { page } = app;
-    try {
-      await openEmgScope(page);
-      const [download] = await Promise.all([
-        page.waitForEvent("download"),
-        page.click(`${SCOPE} button:has-text("PNG")`),
-      ]);
-      expect(download.suggestedFilename()).toMatch(/^Emg\.emg-.*\.png$/);
-      const png = readFileSync((await download.path())!);
-      expect([...png.subarray(0, 8)]).toEqual([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a]);
-      expect(png.subarray(12, 16).toString("latin1")).toBe("IHDR");
-      const canvas = await page.$eval(`${SCOPE} .mp-plot canvas`, (c) => {
-        const el = c as unknown as { width: number; height: number };
-        return { width: el.width, height: el.height };
-      });
-      expect(png.readUInt32BE(16)).toBe(canvas.width);
-      // The legend strip under the plot.
-      expect(png.readUInt32BE(20)).toBeGreaterThan(canvas.height);
-      expect(png.subarray(png.length - 8, png.length - 4).toString("latin1")).toBe("IEND");
-      expect(app.errors.join("\n")).toBe("");
-    } finally {
-      await app.page
-        .screenshot({
-          path: artifact(
-            `scopes-${expect.getState().currentTestName?.slice(52, 70).replace(/\W+/g, "-")}.png`,
-          ),
-        })
-        .catch(() => undefined);
-      await app.close();
-    }
-  }, 180_000);
+  testOnPage("PNG export is a valid PNG of the plot with its legend", async (page) => {
+    await openEmgScope(page);
+    const { name, data: png } = await download(page, "PNG");
+    expect(name).toMatch(/^Emg\.emg-.*\.png$/);
+    expect([...png.subarray(0, 8)]).toEqual([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a]);
+    expect(png.subarray(12, 16).toString("latin1")).toBe("IHDR");
+    const canvas = await page.$eval(`${SCOPE} .mp-plot canvas`, (c) => {
+      const el = c as unknown as { width: number; height: number };
+      return { width: el.width, height: el.height };
+    });
+    expect(png.readUInt32BE(16)).toBe(canvas.width);
+    // The legend strip under the plot.
+    expect(png.readUInt32BE(20)).toBeGreaterThan(canvas.height);
+    expect(png.subarray(png.length - 8, png.length - 4).toString("latin1")).toBe("IEND");
+  });
 
-  test("stacked channels: a lane each, named, with the unit", async () => {
-    const app = await open(chromium, served.url);
-    const { page } = app;
-    try {
+  testOnPage("stacked channels: a lane each, named, with the unit", async (page) => {
+    await page.keyboard.press("2");
+    await openEmgScope(page);
+    await page.selectOption(`${SCOPE} select:near(:text("Layout"))`, "stacked");
+    await page.waitForSelector(`${SCOPE}[data-layout="stacked"]`);
+    expect(await page.textContent(`${SCOPE} .mp-legend`)).toContain("values in mV");
+    await pause(page);
+    // Channel 1 (blue) stays in the top eighth of the plot area, channel 2 (orange) in the next.
+    const area = await plotArea(page);
+    const dpr = await page.evaluate(
+      () => (globalThis as unknown as { devicePixelRatio: number }).devicePixelRatio,
+    );
+    const bbox = await page.$eval(`${SCOPE} .u-over`, (o) => {
+      const el = o as unknown as { offsetTop: number; offsetHeight: number };
+      return { top: el.offsetTop, height: el.offsetHeight };
+    });
+    const laneH = (bbox.height * dpr) / 8;
+    const top = bbox.top * dpr;
+    const blue = await colourRows(page, [0x1f, 0x77, 0xb4]);
+    const orange = await colourRows(page, [0xff, 0x7f, 0x0e]);
+    expect(blue.n).toBeGreaterThan(100);
+    expect(blue.top).toBeGreaterThanOrEqual(top - 1);
+    expect(blue.bottom).toBeLessThanOrEqual(top + laneH + 1);
+    expect(orange.top).toBeGreaterThanOrEqual(top + laneH - 1);
+    expect(orange.bottom).toBeLessThanOrEqual(top + 2 * laneH + 1);
+    // The readout names each lane's value with the unit.
+    await page.mouse.move(area.x + area.width / 2, area.y + area.height / 2);
+    const lines = await readoutLines(page);
+    expect(lines.slice(1).map((l) => l.split(":")[0])).toEqual(EMG);
+    await page.screenshot({ path: artifact("scope-stacked.png") });
+  });
+
+  testOnPage(
+    "spectrum of the window in view with each channel's median frequency (as Welch's)",
+    async (page) => {
       await page.keyboard.press("2");
       await openEmgScope(page);
-      await page.selectOption(`${SCOPE} select:near(:text("Layout"))`, "stacked");
-      await page.waitForSelector(`${SCOPE}[data-layout="stacked"]`);
-      expect(await page.textContent(`${SCOPE} .mp-legend`)).toContain("values in mV");
-      await page.click(`${SCOPE} button:has-text("Pause")`);
-      await page.waitForSelector(`${SCOPE} .mp-foot:has-text("paused")`);
-      // Channel 1 (blue) stays in the top eighth of the plot area, channel 2 (orange) in the next.
-      const area = await plotArea(page);
-      const dpr = await page.evaluate(
-        () => (globalThis as unknown as { devicePixelRatio: number }).devicePixelRatio,
-      );
-      const bbox = await page.$eval(`${SCOPE} .u-over`, (o) => {
-        const el = o as unknown as { offsetTop: number; offsetHeight: number };
-        return { top: el.offsetTop, height: el.offsetHeight };
-      });
-      const laneH = (bbox.height * dpr) / 8;
-      const top = bbox.top * dpr;
-      const blue = await colourRows(page, [0x1f, 0x77, 0xb4]);
-      const orange = await colourRows(page, [0xff, 0x7f, 0x0e]);
-      expect(blue.n).toBeGreaterThan(100);
-      expect(blue.top).toBeGreaterThanOrEqual(top - 1);
-      expect(blue.bottom).toBeLessThanOrEqual(top + laneH + 1);
-      expect(orange.top).toBeGreaterThanOrEqual(top + laneH - 1);
-      expect(orange.bottom).toBeLessThanOrEqual(top + 2 * laneH + 1);
-      // The readout names each lane's value with the unit.
-      await page.mouse.move(area.x + area.width / 2, area.y + area.height / 2);
-      const lines = await page.locator(`${SCOPE} .mp-readout div`).allTextContents();
-      expect(lines.slice(1).map((l) => l.split(":")[0])).toEqual(EMG);
-      await page.screenshot({ path: artifact("scope-stacked.png") });
-      expect(app.errors.join("\n")).toBe("");
-    } finally {
-      await app.page
-        .screenshot({
-          path: artifact(
-            `scopes-${expect.getState().currentTestName?.slice(52, 70).replace(/\W+/g, "-")}.png`,
-          ),
-        })
-        .catch(() => undefined);
-      await app.close();
-    }
-  }, 180_000);
-
-  test("spectrum of the window in view with each channel's median frequency (as Welch's)", async () => {
-    const app = await open(chromium, served.url);
-    const { page } = app;
-    try {
-      await page.keyboard.press("2");
-      await openEmgScope(page);
-      await page.click(`${SCOPE} button:has-text("Pause")`);
-      await page.waitForSelector(`${SCOPE} .mp-foot:has-text("paused")`);
+      await pause(page);
       await page.click(`${SCOPE} button:has-text("Spectrum")`);
       const items = page.locator(`${SCOPE} .mp-mdf-item`);
       await items.nth(7).waitFor({ timeout: 60_000 });
       const shown = await items.evaluateAll((els) =>
         els.map((e) => {
           const el = e as unknown as { getAttribute(a: string): string };
-          return { name: el.getAttribute("data-channel"), hz: Number(el.getAttribute("data-hz")) };
+          return {
+            name: el.getAttribute("data-channel"),
+            hz: Number(el.getAttribute("data-hz")),
+          };
         }),
       );
       expect(shown.map((s) => s.name)).toEqual(EMG);
@@ -555,23 +528,12 @@ describe.skipIf(!haveChromium)("scopes and panel views (browser build, Chromium)
         expect(mdf).toBeLessThan(100);
       }
       await page.screenshot({ path: artifact("scope-spectrum.png") });
-      expect(app.errors.join("\n")).toBe("");
-    } finally {
-      await app.page
-        .screenshot({
-          path: artifact(
-            `scopes-${expect.getState().currentTestName?.slice(52, 70).replace(/\W+/g, "-")}.png`,
-          ),
-        })
-        .catch(() => undefined);
-      await app.close();
-    }
-  }, 180_000);
+    },
+  );
 
-  test("a panel pops out into its own window, draws there, and comes back when it closes", async () => {
-    const app = await open(chromium, served.url);
-    const { page } = app;
-    try {
+  testOnPage(
+    "a panel pops out into its own window, draws there, and comes back when it closes",
+    async (page) => {
       await openEmgScope(page);
       const [popup] = await Promise.all([
         page.context().waitForEvent("page"),
@@ -590,7 +552,7 @@ describe.skipIf(!haveChromium)("scopes and panel views (browser build, Chromium)
       await frames(page, 10);
       expect((await plot.screenshot()).equals(a)).toBe(false);
       // Its legend names the channels there too.
-      expect(await popup.locator(".mp-legend .mp-chip").allTextContents()).toEqual(EMG);
+      expect(await texts(popup, ".mp-legend .mp-chip")).toEqual(EMG);
       await popup.screenshot({ path: artifact("panel-popped-out.png") });
       // Closing the window brings the panel back into the page.
       await popup.close();
@@ -598,44 +560,31 @@ describe.skipIf(!haveChromium)("scopes and panel views (browser build, Chromium)
       expect(await page.textContent('[data-panel="Emg"] .panel-frame__body')).not.toContain(
         "Shown in its own window",
       );
-      expect(app.errors.join("\n")).toBe("");
-    } finally {
-      await app.close();
-    }
-  }, 180_000);
+    },
+  );
 
-  test("the docked panels' edge drags wider and the scope widens with it", async () => {
-    const app = await open(chromium, served.url);
-    const { page } = app;
-    try {
-      await openEmgScope(page);
-      const width = (sel: string) =>
-        page.$eval(sel, (e) => (e as unknown as { offsetWidth: number }).offsetWidth);
-      const dock0 = await width("aside.dock");
-      const plot0 = await width(`${SCOPE} .mp-plot canvas`);
-      const edge = (await page.locator(".dock-resizer").boundingBox())!;
-      await page.mouse.move(edge.x + edge.width / 2, edge.y + 200);
-      await page.mouse.down();
-      await page.mouse.move(edge.x + edge.width / 2 - 300, edge.y + 200, { steps: 6 });
-      await page.mouse.up();
-      expect(Math.abs((await width("aside.dock")) - (dock0 + 300))).toBeLessThanOrEqual(2);
-      // The scope's plot follows its panel's width.
-      await page.waitForFunction(
-        ([sel, w]) =>
-          ((
-            globalThis as unknown as { document: { querySelector(q: string): { width: number } } }
-          ).document.querySelector(sel).width ?? 0) >
-          (w as number) + 200,
-        [`${SCOPE} .mp-plot canvas`, plot0] as const,
-      );
-      // Arrow keys on the focused edge: 40 px a press.
-      await page.focus(".dock-resizer");
-      await page.keyboard.press("ArrowLeft");
-      expect(Math.abs((await width("aside.dock")) - (dock0 + 340))).toBeLessThanOrEqual(2);
-      await page.screenshot({ path: artifact("dock-wide.png") });
-      expect(app.errors.join("\n")).toBe("");
-    } finally {
-      await app.close();
-    }
-  }, 180_000);
+  testOnPage("the docked panels' edge drags wider and the scope widens with it", async (page) => {
+    await openEmgScope(page);
+    const width = (sel: string) =>
+      page.$eval(sel, (e) => (e as unknown as { offsetWidth: number }).offsetWidth);
+    const dock0 = await width("aside.dock");
+    const plot0 = await width(`${SCOPE} .mp-plot canvas`);
+    const edge = (await page.locator(".dock-resizer").boundingBox())!;
+    await drag(page, edge.x + edge.width / 2, edge.y + 200, -300, 6);
+    expect(Math.abs((await width("aside.dock")) - (dock0 + 300))).toBeLessThanOrEqual(2);
+    // The scope's plot follows its panel's width.
+    await page.waitForFunction(
+      ([sel, w]) =>
+        ((
+          globalThis as unknown as { document: { querySelector(q: string): { width: number } } }
+        ).document.querySelector(sel).width ?? 0) >
+        (w as number) + 200,
+      [`${SCOPE} .mp-plot canvas`, plot0] as const,
+    );
+    // Arrow keys on the focused edge: 40 px a press.
+    await page.focus(".dock-resizer");
+    await page.keyboard.press("ArrowLeft");
+    expect(Math.abs((await width("aside.dock")) - (dock0 + 340))).toBeLessThanOrEqual(2);
+    await page.screenshot({ path: artifact("dock-wide.png") });
+  });
 });
