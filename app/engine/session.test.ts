@@ -4,7 +4,13 @@ import type { DataMessage, EngineMessage } from "./protocol";
 import type { Runtime } from "./runtime/runtime";
 import { runVirtual } from "./runtime/virtual";
 import { Frame } from "./frame";
-import { EngineSession, Watch, type LoopHooks, type SessionPlatform } from "./session";
+import {
+  EngineSession,
+  Watch,
+  withBuiltInActions,
+  type LoopHooks,
+  type SessionPlatform,
+} from "./session";
 import { testCatalog } from "./test-blocks";
 import { noResources } from "./testing";
 
@@ -45,6 +51,17 @@ G: { Type: Gain, Inputs: [C], Params: { Gain: 2 } }
 const replies = (sent: EngineMessage[]) => sent.filter((m) => m.type === "reply");
 
 describe("EngineSession", () => {
+  test("a block's actions, then the built-in ones it does not define (its own reset once)", () => {
+    const names = (own: { name: string }[]) => withBuiltInActions(own).map((a) => a.name);
+    expect(names([{ name: "train" }])).toEqual(["train", "reset", "subscribe", "unsubscribe"]);
+    expect(names([{ name: "reset" }, { name: "save" }])).toEqual([
+      "reset",
+      "save",
+      "subscribe",
+      "unsubscribe",
+    ]);
+  });
+
   test("hello, load (graph with schemas), start, telemetry, stop", async () => {
     const f = fakePlatform();
     const s = new EngineSession(testCatalog, f.platform);

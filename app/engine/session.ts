@@ -101,6 +101,13 @@ const BUILT_IN_ACTIONS = [
   },
 ];
 
+/** A block's actions then the built-in ones it does not define itself (its own `reset` wins). */
+export function withBuiltInActions<A extends { name: string }>(
+  own: A[],
+): (A | (typeof BUILT_IN_ACTIONS)[number])[] {
+  return [...own, ...BUILT_IN_ACTIONS.filter((b) => !own.some((a) => a.name === b.name))];
+}
+
 /** Seconds of panel data one flush may carry (telemetry flushes every 50 ms). */
 const WATCH_HOLD_S = 0.25;
 /** Values one watch may hold, whatever its rate and shape (8 MiB). */
@@ -635,7 +642,7 @@ export class EngineSession {
         params: (node.params ?? {}) as Record<string, unknown>,
         fileParams: this.fileParams.get(b.name) ?? {},
         paramsSchema: schema,
-        actions: [...own, ...BUILT_IN_ACTIONS],
+        actions: withBuiltInActions(own),
         ...(b.layout ? { layout: b.layout } : {}),
         ...(b.path !== undefined ? { path: b.path } : {}),
       };

@@ -1,7 +1,7 @@
 import { readFileSync } from "node:fs";
 import { join } from "node:path";
 import { beforeAll, describe, expect, test } from "vitest";
-import { vectorShape } from "../../engine";
+import { loadPipeline, Runtime, runVirtual, vectorShape, VirtualClock } from "../../engine";
 import { BlockHarness, runVirtualPipeline } from "../../engine/testing";
 import { convertLegacy, vectors } from "../../../tests/support/blocks";
 import { memoryResources, REPO_ROOT } from "../../../tests/support/fs-resources";
@@ -211,6 +211,34 @@ describe("IncrementalPredictor", () => {
     expect(fresh.text).toMatch(/loaded copy\.json: rff \(D 20, γ 0.5, λ 1\)/);
     fresh.instance.reset!();
     expect(fresh.text).toBe("untrained (waiting for a target)");
+  });
+
+  test("the block's own reset action (Reset model) is what invoking 'reset' runs", async () => {
+    const files: Record<string, string> = {};
+    const h = await predictor({}, 2, 2, files);
+    h.push(vectors([0], [[1, 0]]), 1);
+    h.push(vectors([1, 2, 3], [point(1), point(2), point(3)]), 0);
+    run(h, "save", "m.json");
+    await settle();
+    const yaml =
+      "T: { Type: ScheduledTimer, DesiredRate: 25 }\n" +
+      "F: { Type: SinGenerator, Inputs: [T], Params: { Components: 2 } }\n" +
+      "P: { Type: IncrementalPredictor, Inputs: [F], Params: { File: m.json } }\n";
+    const clock = new VirtualClock(0);
+    const created = await Runtime.create({
+      spec: loadPipeline(yaml, "p.yaml", catalog).spec!,
+      catalog,
+      clock,
+      virtual: true,
+      resources: memoryResources(files),
+    });
+    const rt = created.runtime!;
+    rt.start();
+    runVirtual(rt, clock, 0.2);
+    // The built-in reset would go back to the model loaded from the File; the action forgets it.
+    expect(rt.invoke("P", "reset")).toBe("forgot 3 samples");
+    expect(rt.invoke("P", "inspect")).toMatch(/: 0 samples learnt/);
+    rt.dispose();
   });
 
   test("a model file that does not fit is refused with the file and the reason", async () => {

@@ -1116,18 +1116,15 @@ export class Runtime {
       }
       return this.setSubscribed(block, arg, action === "subscribe");
     }
-    if (action === "reset") {
+    const a = node.instance.actions?.[action];
+    // A block's own `reset` action (a predictor's "Reset model") takes the place of the built-in.
+    if (action === "reset" && !a) {
       node.instance.reset?.();
       return `${block} reset`;
     }
-    const a = node.instance.actions?.[action];
     if (!a) {
-      const names = [
-        "subscribe",
-        "unsubscribe",
-        "reset",
-        ...Object.keys(node.instance.actions ?? {}),
-      ];
+      const own = Object.keys(node.instance.actions ?? {});
+      const names = [...new Set(["subscribe", "unsubscribe", "reset", ...own])];
       throw new Error(
         `block '${block}' has no action '${action}' (its actions: ${names.join(", ")})`,
       );
