@@ -16,16 +16,20 @@ import { parseArgs } from "node:util";
 import { formatDiagnostic } from "../engine/diagnostics";
 import { PipelineDocument } from "../engine/pipeline/document";
 import type { SimulateOptions } from "../engine/pipeline/simulate";
-import type { Telemetry } from "../engine/runtime/runtime";
 import { Host, webRoot } from "../host/host";
 import { serveStatic } from "../host/web-server";
 import { runBench } from "./bench";
 import { cmdNewBlock, newBlockHelp } from "./new-block";
 import { cmdRepair, repairHelp } from "./repair";
 import { cmdSimulate, simulateHelp } from "./simulate";
-import { NilsPodSimulator } from "../devices/nilspod-simulator";
-import type { BleBridge } from "../engine/io";
-import { renderTable } from "./table";
+import { RunConsole, type RunEnd } from "./run-console";
+import {
+  hostOptions,
+  parseRunOptions,
+  SIMULATE_ARGS,
+  simulateOption,
+  type RunOptions,
+} from "./run-options";
 import { cmdTestBlock, testBlockHelp } from "./test-block";
 
 const VERSION = "0.1.0";
@@ -100,36 +104,6 @@ function out(s: string): void {
 }
 function err(s: string): void {
   process.stderr.write(s + "\n");
-}
-
-/** `--simulate-devices [--keep-network]` as the host's option (undefined: off). */
-function simulateOption(v: {
-  "simulate-devices"?: boolean;
-  "keep-network"?: boolean;
-}): SimulateOptions | undefined | string {
-  if (v["keep-network"] && !v["simulate-devices"]) {
-    return "--keep-network only applies with --simulate-devices";
-  }
-  return v["simulate-devices"] ? { keepNetwork: v["keep-network"] === true } : undefined;
-}
-
-const SIMULATE_ARGS = {
-  "simulate-devices": { type: "boolean", default: false },
-  "keep-network": { type: "boolean", default: false },
-} as const;
-
-/** Peripherals `--simulate-ble` can play behind the host's Bluetooth LE bridge. */
-const SIMULATED_BLE: Record<string, () => BleBridge & { close(): void }> = {
-  nilspod: () => new NilsPodSimulator({ realtime: true }),
-};
-
-/** `--simulate-ble NAME`: the simulated peripheral's bridge, or why not (undefined: off). */
-function bleOption(name: string | undefined): (BleBridge & { close(): void }) | undefined | string {
-  if (name === undefined) return undefined;
-  const make = SIMULATED_BLE[name];
-  return make
-    ? make()
-    : `--simulate-ble: no simulated peripheral '${name}' (peripherals: ${Object.keys(SIMULATED_BLE).join(", ")})`;
 }
 
 async function cmdValidate(args: string[]): Promise<number> {
@@ -234,180 +208,74 @@ async function cmdFormat(args: string[]): Promise<number> {
   return values.check && changed > 0 ? 1 : 0;
 }
 
-function summaryLines(t: Telemetry): string[] {
-  const lines: string[] = [];
-  const ms = (x: number): string => (x < 1 ? x.toFixed(3) : x.toFixed(2));
-  for (const b of t.blocks) {
-    if (b.timer && b.timer.fired > 0 && b.timer.latenessP50Us === b.timer.latenessP50Us) {
-      const missed =
-        b.timer.catchUp === "skip" ? `${b.timer.missed} skipped (CatchUp: skip)` : "none lost";
-      lines.push(
-        `${b.name}: ${b.timer.fired} ticks (${missed}), batching ${b.timer.batchingMs} ms, wake-up lateness p50 ${b.timer.latenessP50Us} µs, p99 ${b.timer.latenessP99Us} µs, max ${Math.round(b.timer.latenessMaxUs)} µs`,
-      );
-    }
-  }
-  const delayed = t.blocks.filter((b) => b.delay.n > 0);
-  if (delayed.length > 0) {
-    const worst = delayed.reduce((a, b) => (b.delay.p99Ms > a.delay.p99Ms ? b : a));
-    lines.push(
-      `delivery delay (processing − event time): worst p99 ${ms(worst.delay.p99Ms)} ms (${worst.name}), max ${ms(Math.max(...delayed.map((b) => b.delay.maxMs)))} ms`,
-    );
-  }
-  return lines;
-}
-
+/**
+ * `mosaic run FILE [options]`: loads the pipeline, runs it until its input ends, its duration,
+ * Ctrl-C or a fatal error, and shows it as it goes (RunConsole). Exit 0 on success, 1 on a
+ * runtime failure, 2 on wrong options or an invalid file.
+ */
 async function cmdRun(args: string[]): Promise<number> {
-  const { values, positionals } = parseArgs({
-    args,
-    allowPositionals: true,
-    options: {
-      duration: { type: "string" },
-      clock: { type: "string", default: "realtime" },
-      json: { type: "boolean", default: false },
-      precision: { type: "boolean", default: false },
-      "batching-ms": { type: "string" },
-      "log-dir": { type: "string" },
-      start: { type: "string" },
-      warmup: { type: "string" },
-      "telemetry-hz": { type: "string" },
-      "simulate-ble": { type: "string" },
-      ...SIMULATE_ARGS,
-    },
-  });
-  const simulate = simulateOption(values);
-  if (typeof simulate === "string") {
-    err(`mosaic run: ${simulate}`);
+  const o = parseRunOptions(args);
+  if (typeof o === "string") {
+    err(o);
     return 2;
   }
-  const ble = bleOption(values["simulate-ble"]);
-  if (typeof ble === "string") {
-    err(`mosaic run: ${ble}`);
-    return 2;
-  }
-  const file = positionals[0];
-  if (!file || positionals.length > 1) {
-    err("usage: mosaic run FILE [--duration S] [--clock realtime|virtual] [--json]");
-    return 2;
-  }
-  const mode = values.clock;
-  if (mode !== "realtime" && mode !== "virtual") {
-    err(`mosaic run: --clock must be realtime or virtual, not '${mode}'`);
-    return 2;
-  }
-  const duration = values.duration !== undefined ? Number(values.duration) : undefined;
-  if (duration !== undefined && !(duration > 0)) {
-    err(`mosaic run: --duration must be a positive number of seconds, not '${values.duration}'`);
-    return 2;
-  }
-  const start = values.start !== undefined ? Number(values.start) : 0;
-  if (!Number.isFinite(start)) {
-    err(`mosaic run: --start must be a number of seconds, not '${values.start}'`);
-    return 2;
-  }
-  const warmup = values.warmup !== undefined ? Number(values.warmup) : 0;
-  if (!(warmup >= 0)) {
-    err(`mosaic run: --warmup must be a number of seconds, not '${values.warmup}'`);
-    return 2;
-  }
-  const telemetryHz = values["telemetry-hz"] !== undefined ? Number(values["telemetry-hz"]) : 20;
-  if (!(telemetryHz > 0 && telemetryHz <= 100)) {
-    err(`mosaic run: --telemetry-hz must be between 0 and 100, not '${values["telemetry-hz"]}'`);
-    return 2;
-  }
-  const batchingMs =
-    values["batching-ms"] !== undefined ? Number(values["batching-ms"]) : undefined;
-  if (batchingMs !== undefined && !(batchingMs >= 0 && batchingMs <= 1000)) {
-    err(
-      `mosaic run: --batching-ms must be between 0 and 1000 milliseconds, not '${values["batching-ms"]}'`,
-    );
-    return 2;
-  }
-  const json = values.json;
-  const tty = process.stdout.isTTY === true && !json;
-  const color = tty && !process.env.NO_COLOR;
-  let latest: Telemetry | undefined;
-  let drawn = 0;
-  let fatal = false;
-  let blockErrors = 0;
-  const draw = (): void => {
-    if (!latest || !tty) return;
-    const lines = renderTable(latest, { color, width: process.stdout.columns || 120 });
-    let s = drawn > 0 ? `\x1b[${drawn}F` : "";
-    for (const l of lines) s += `\x1b[2K${l}\n`;
-    process.stdout.write(s);
-    drawn = lines.length;
-  };
-  let resolveDone!: (reason: string) => void;
-  const done = new Promise<string>((r) => (resolveDone = r));
-  const { host, diagnostics } = await Host.load(
-    file,
-    {
-      mode,
-      precision: values.precision,
-      ...(batchingMs !== undefined ? { batchingS: batchingMs / 1000 } : {}),
-      ...(values["log-dir"] !== undefined ? { logDir: resolve(values["log-dir"]) } : {}),
-      virtualStart: start,
-      telemetryHz,
-      ...(mode === "virtual" && duration !== undefined ? { virtualDuration: duration } : {}),
-      ...(simulate ? { simulateDevices: simulate } : {}),
-      ...(ble ? { ble } : {}),
-    },
-    {
-      // Only what is used: the JSON lines (printed as the workers encoded them), or the objects
-      // for the live table on a terminal.
-      ...(json ? { telemetryLine: (line: string) => out(line) } : {}),
-      ...(tty ? { telemetry: (t: Telemetry) => (latest = t) } : {}),
-      event: (e) => {
-        if (e.level === "error") blockErrors++;
-        if (json) out(JSON.stringify({ type: "event", ...e }));
-        else {
-          if (tty && drawn > 0) {
-            process.stdout.write(`\x1b[${drawn}F\x1b[J`);
-            drawn = 0;
-          }
-          err(`${e.level}: ${e.block}: ${e.message}`);
-        }
-      },
-      finished: () => resolveDone("finished"),
-      fatal: (m) => {
-        fatal = true;
-        if (json) out(JSON.stringify({ type: "fatal", message: m }));
-        else err(`fatal: ${m}`);
-        resolveDone("fatal");
-      },
-    },
-  );
+  const view = new RunConsole(o.json, out, err);
+  const { host, diagnostics } = await Host.load(o.file, hostOptions(o), view.events());
   for (const d of diagnostics) err(formatDiagnostic(d));
   if (!host) {
-    err(`${file}: invalid pipeline, not started`);
+    err(`${o.file}: invalid pipeline, not started`);
     return 2;
   }
-  if (mode === "virtual" && duration === undefined && !host.plan?.blocks.some((b) => b.finite)) {
+  if (
+    o.mode === "virtual" &&
+    o.duration === undefined &&
+    !host.plan?.blocks.some((b) => b.finite)
+  ) {
     err(
       "note: under the virtual clock without --duration and without a finite source (a FilePlayer " +
         "without Loop), the run goes on until Ctrl-C",
     );
   }
-  const onSig = (): void => resolveDone("interrupted");
+  const run = await runUntilStopped(host, o, view);
+  const final = await host.stop();
+  o.ble?.close();
+  return view.finish(final, {
+    ...run,
+    logs: host.logFiles,
+    virtualDuration: o.mode === "virtual" && o.duration !== undefined,
+  });
+}
+
+/**
+ * Starts the host and waits for the run to stop: Ctrl-C (SIGINT, SIGTERM), the realtime
+ * `--duration`, or the view's own reasons (input ended, fatal error). After `--warmup` the
+ * timing statistics are reset and the measured time starts again.
+ */
+async function runUntilStopped(
+  host: Host,
+  o: RunOptions,
+  view: RunConsole,
+): Promise<Pick<RunEnd, "reason" | "wallSeconds" | "measuredSeconds">> {
+  const onSig = (): void => view.stop("interrupted");
   process.once("SIGINT", onSig);
   process.once("SIGTERM", onSig);
-  const redraw = tty ? setInterval(draw, 250) : undefined;
+  const redraw = view.startRedrawing();
   const timer =
-    mode === "realtime" && duration !== undefined
-      ? setTimeout(() => resolveDone("duration"), duration * 1000)
+    o.mode === "realtime" && o.duration !== undefined
+      ? setTimeout(() => view.stop("duration"), o.duration * 1000)
       : undefined;
   const t0 = performance.now();
   let measuredFrom = t0;
   const warm =
-    warmup > 0
+    o.warmup > 0
       ? setTimeout(() => {
           measuredFrom = performance.now();
           void host.control({ op: "resetTiming" });
-          if (json) out(JSON.stringify({ type: "warmup-done", t: Date.now() / 1000 }));
-        }, warmup * 1000)
+          view.warmupDone();
+        }, o.warmup * 1000)
       : undefined;
   host.start();
-  const reason = await done;
+  const reason = await view.stopped;
   const wallSeconds = (performance.now() - t0) / 1000;
   const measuredSeconds = (performance.now() - measuredFrom) / 1000;
   if (warm) clearTimeout(warm);
@@ -415,41 +283,7 @@ async function cmdRun(args: string[]): Promise<number> {
   if (redraw) clearInterval(redraw);
   process.off("SIGINT", onSig);
   process.off("SIGTERM", onSig);
-  const final = await host.stop();
-  ble?.close();
-  latest = final;
-  const code = fatal ? 1 : blockErrors > 0 ? 1 : 0;
-  if (json) {
-    out(
-      JSON.stringify({
-        type: "summary",
-        reason,
-        exitCode: code,
-        wallSeconds,
-        measuredSeconds,
-        logs: host.logFiles,
-        ...final,
-      }),
-    );
-  } else {
-    if (tty) draw();
-    else for (const l of renderTable(final, { color: false })) out(l);
-    for (const l of summaryLines(final)) out(l);
-    const why =
-      reason === "finished"
-        ? mode === "virtual" && duration !== undefined
-          ? "virtual duration reached"
-          : "input exhausted"
-        : reason === "duration"
-          ? "duration reached"
-          : reason === "interrupted"
-            ? "interrupted"
-            : "failed";
-    out(
-      `stopped: ${why}${blockErrors ? `; ${blockErrors} block error${blockErrors === 1 ? "" : "s"} (see above)` : ""}`,
-    );
-  }
-  return code;
+  return { reason, wallSeconds, measuredSeconds };
 }
 
 async function cmdWeb(args: string[]): Promise<number> {
