@@ -34,13 +34,16 @@ const SIMULATED_BLE: Record<string, () => SimulatedBle> = {
   nilspod: () => new NilsPodSimulator({ realtime: true }),
 };
 
-/** `--simulate-ble NAME`: the simulated peripheral's bridge, or why not (undefined: off). */
-function bleOption(name: string | undefined): SimulatedBle | undefined | string {
+/**
+ * `--simulate-ble NAME`: what starts the simulated peripheral (once every option is checked, so a
+ * refused command line leaves none running), or why not (undefined: off).
+ */
+function bleOption(name: string | undefined): (() => SimulatedBle) | undefined | string {
   if (name === undefined) return undefined;
-  const make = SIMULATED_BLE[name];
-  return make
-    ? make()
-    : `--simulate-ble: no simulated peripheral '${name}' (peripherals: ${Object.keys(SIMULATED_BLE).join(", ")})`;
+  return (
+    SIMULATED_BLE[name] ??
+    `--simulate-ble: no simulated peripheral '${name}' (peripherals: ${Object.keys(SIMULATED_BLE).join(", ")})`
+  );
 }
 
 export interface RunOptions {
@@ -114,8 +117,8 @@ function runNumbers(
 
 /**
  * `mosaic run`'s options, or the line that says what is wrong with them (exit 2). The checks go
- * in this order: the simulation options, `--simulate-ble` (its peripheral starts here), one
- * FILE, `--clock`, the numbers.
+ * in this order: the simulation options, `--simulate-ble`, one FILE, `--clock`, the numbers; the
+ * simulated peripheral starts once they all passed.
  */
 export function parseRunOptions(args: string[]): RunOptions | string {
   const { values, positionals } = readArgs(args);
@@ -141,7 +144,7 @@ export function parseRunOptions(args: string[]): RunOptions | string {
     precision: values.precision,
     logDir: values["log-dir"],
     simulate,
-    ble,
+    ble: ble?.(),
   };
 }
 

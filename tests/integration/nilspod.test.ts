@@ -402,5 +402,18 @@ describe("mosaic run --simulate-ble nilspod", () => {
       2,
       "mosaic run: --simulate-ble: no simulated peripheral 'myo' (peripherals: nilspod)",
     ]);
+    // A refused command line starts no peripheral: the CLI exits at once.
+    const late = runCli([
+      "run",
+      "pipelines/devices/nilspod.yaml",
+      "--simulate-ble",
+      "nilspod",
+      "--clock",
+      "x",
+    ]);
+    expect([late.code, late.stderr.trim()]).toEqual([
+      2,
+      "mosaic run: --clock must be realtime or virtual, not 'x'",
+    ]);
   });
 });
