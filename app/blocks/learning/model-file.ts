@@ -539,15 +539,35 @@ function describe(v: Json): string {
  */
 export function parseModelFile(text: string, file: string): ModelFile {
   const c = new Check(file);
-  let doc: Json;
+  const top = c.object(parseJson(c, text), "the file");
+  checkFormat(c, top);
+  const options = readOptions(c, top);
+  const samples = c.int(
+    top.samplesSeen,
+    "samplesSeen",
+    0,
+    Number.MAX_SAFE_INTEGER,
+    "a whole number >= 0",
+  );
+  const lambdaEff = c.number(top.lambdaEffective, "lambdaEffective", (x) => x > 0, "a number > 0");
+  const created = typeof top.created === "string" ? top.created : "";
+  const block = typeof top.block === "string" ? top.block : null;
+  const state = new StateReader(c, top, options, samples, lambdaEff).read();
+  return { options, samplesSeen: samples, created, block, state };
+}
+
+function parseJson(c: Check, text: string): Json {
   try {
-    doc = JSON.parse(text);
+    return JSON.parse(text);
   } catch (e) {
     // Not JSON.parse's whole message: it quotes the text around the error (`"root:$6$ab"...`).
     const said = JSON.stringify(errorMessage(e).split(', "')[0]).slice(1, -1);
     c.fail(`not a MOSAIC model file: invalid JSON (${said})`);
   }
-  const top = c.object(doc, "the file");
+}
+
+/** The format name and a version this MOSAIC reads. */
+function checkFormat(c: Check, top: Record<string, Json>): void {
   if (top.format !== MODEL_FORMAT) {
     c.fail(
       `not a MOSAIC model file: "format" is ${describe(top.format)}; expected "${MODEL_FORMAT}"`,
@@ -559,6 +579,10 @@ export function parseModelFile(text: string, file: string): ModelFile {
       `format version ${version} is newer than this MOSAIC reads (${MODEL_VERSION}); update MOSAIC`,
     );
   }
+}
+
+/** Kind, sizes and hyper-parameters (the rff ones only for rff). */
+function readOptions(c: Check, top: Record<string, Json>): ResolvedLearningOptions {
   if (top.kind !== "ridge" && top.kind !== "rff") {
     c.fail(`kind is ${describe(top.kind)}; expected "ridge" or "rff"`);
   }
@@ -592,39 +616,37 @@ export function parseModelFile(text: string, file: string): ModelFile {
     maxClasses: LEARNING_DEFAULTS.maxClasses,
     ldaOutput: LEARNING_DEFAULTS.ldaOutput,
   };
-  if (rff) {
-    options.gamma = c.number(top.gamma, "gamma", (x) => x > 0, "a number > 0");
-    options.features = c.int(top.D, "D", 1, MAX_DIM, "a whole number of features (1–2048)");
-    options.seed = c.int(top.seed ?? 0, "seed", 0, Number.MAX_SAFE_INTEGER, "a whole number >= 0");
-    if (options.normalize) {
-      options.normalizeSamples = c.int(
-        top.normalizeSamples,
-        "normalizeSamples",
-        2,
-        100_000,
-        "a whole number of samples (2–100000)",
-      );
-    }
-  }
-  const samples = c.int(
-    top.samplesSeen,
-    "samplesSeen",
-    0,
-    Number.MAX_SAFE_INTEGER,
-    "a whole number >= 0",
-  );
-  const lambdaEff = c.number(top.lambdaEffective, "lambdaEffective", (x) => x > 0, "a number > 0");
-  const created = typeof top.created === "string" ? top.created : "";
-  const block = typeof top.block === "string" ? top.block : null;
-  const p = rff ? options.features : d;
-  const model = c.object(top.model, "model");
-  const st = c.object(top.state, "state");
-  const fitStats = c.object(st.fitStats, "state.fitStats");
-  const norm = options.normalize ? c.object(top.normalizer, "normalizer") : null;
+  if (rff) readRffOptions(c, top, options);
+  return options;
+}
 
-  // The flat state, in the Rust section order (mosaic-learn `Model::state_sections`).
+function readRffOptions(
+  c: Check,
+  top: Record<string, Json>,
+  options: ResolvedLearningOptions,
+): void {
+  options.gamma = c.number(top.gamma, "gamma", (x) => x > 0, "a number > 0");
+  options.features = c.int(top.D, "D", 1, MAX_DIM, "a whole number of features (1–2048)");
+  options.seed = c.int(top.seed ?? 0, "seed", 0, Number.MAX_SAFE_INTEGER, "a whole number >= 0");
+  if (options.normalize) {
+    options.normalizeSamples = c.int(
+      top.normalizeSamples,
+      "normalizeSamples",
+      2,
+      100_000,
+      "a whole number of samples (2–100000)",
+    );
+  }
+}
+
+/** The flat state's sections and lengths, in the Rust order (mosaic-learn `Model::state_sections`). */
+function stateSections(o: ResolvedLearningOptions): [string, number][] {
+  const rff = o.kind === "rff";
+  const d = o.inputs;
+  const m = o.outputs;
+  const p = rff ? o.features : d;
   const sections: [string, number][] = [];
-  if (options.normalize) sections.push(["normalizer", 2 + 2 * d]);
+  if (o.normalize) sections.push(["normalizer", 2 + 2 * d]);
   if (rff) sections.push(["omega", p * d], ["offset", p]);
   sections.push(
     ["meta", 3],
@@ -637,29 +659,76 @@ export function parseModelFile(text: string, file: string): ModelFile {
     ["intercept", m],
     ["fit_stats", 1 + 3 * m],
   );
-  const state = new Float64Array(sections.reduce((s, x) => s + x[1], 0));
-  const inputs = rff ? "one per feature" : "one per input";
-  let at = 0;
-  for (const [name, len] of sections) {
+  return sections;
+}
+
+/** Checks the file's arrays and copies them, section by section, into the flat state. */
+class StateReader {
+  private readonly d: number;
+  private readonly m: number;
+  /** Columns of the normal equations: features for rff, else inputs. */
+  private readonly p: number;
+  /** What each of the `p` values is, for the messages. */
+  private readonly inputs: string;
+  private readonly model: Record<string, Json>;
+  private readonly st: Record<string, Json>;
+  private readonly fitStats: Record<string, Json>;
+  private readonly norm: Record<string, Json> | null;
+  private readonly sections: [string, number][];
+  private readonly state: Float64Array;
+
+  constructor(
+    private readonly c: Check,
+    top: Record<string, Json>,
+    options: ResolvedLearningOptions,
+    private readonly samples: number,
+    private readonly lambdaEff: number,
+  ) {
+    const rff = options.kind === "rff";
+    this.d = options.inputs;
+    this.m = options.outputs;
+    this.p = rff ? options.features : this.d;
+    this.inputs = rff ? "one per feature" : "one per input";
+    this.model = c.object(top.model, "model");
+    this.st = c.object(top.state, "state");
+    this.fitStats = c.object(this.st.fitStats, "state.fitStats");
+    this.norm = options.normalize ? c.object(top.normalizer, "normalizer") : null;
+    this.sections = stateSections(options);
+    this.state = new Float64Array(this.sections.reduce((s, x) => s + x[1], 0));
+  }
+
+  read(): Float64Array {
+    let at = 0;
+    for (const [name, len] of this.sections) {
+      this.section(name, at);
+      at += len;
+    }
+    return this.state;
+  }
+
+  private section(name: string, at: number): void {
+    const { c, model, st, state, p, m, inputs } = this;
     switch (name) {
-      case "normalizer": {
-        const n = norm!;
-        state[at] = c.number(n.count, "normalizer.count", (x) => x >= 0, "a count >= 0");
-        state[at + 1] = c.bool(n.frozen, "normalizer.frozen") ? 1 : 0;
-        c.vector(n.mean, "normalizer.mean", d, "one per input", state, at + 2);
-        c.vector(n.m2, "normalizer.m2", d, "one per input", state, at + 2 + d);
+      case "normalizer":
+        this.normalizer(at);
         break;
-      }
       case "omega":
-        c.matrix(model.omega, "model.omega", p, d, "one per feature", "one per input", state, at);
+        c.matrix(
+          model.omega,
+          "model.omega",
+          p,
+          this.d,
+          "one per feature",
+          "one per input",
+          state,
+          at,
+        );
         break;
       case "offset":
         c.vector(model.offset, "model.offset", p, "one per feature", state, at);
         break;
       case "meta":
-        state[at] = samples;
-        state[at + 1] = c.number(st.weightSum, "state.weightSum", (x) => x >= 0, "a number >= 0");
-        state[at + 2] = lambdaEff;
+        this.meta(at);
         break;
       case "penalty":
         c.vector(model.penalty, "model.penalty", p, inputs, state, at);
@@ -683,20 +752,35 @@ export function parseModelFile(text: string, file: string): ModelFile {
         c.vector(model.intercept, "model.intercept", m, "one per output", state, at);
         break;
       case "fit_stats":
-        state[at] = c.number(
-          fitStats.weight,
-          "state.fitStats.weight",
-          (x) => x >= 0,
-          "a number >= 0",
-        );
-        c.vector(fitStats.mean, "state.fitStats.mean", m, "one per output", state, at + 1);
-        c.vector(fitStats.m2, "state.fitStats.m2", m, "one per output", state, at + 1 + m);
-        c.vector(fitStats.sse, "state.fitStats.sse", m, "one per output", state, at + 1 + 2 * m);
+        this.fitStatsSection(at);
         break;
     }
-    at += len;
   }
-  return { options, samplesSeen: samples, created, block, state };
+
+  private normalizer(at: number): void {
+    const { c, state, d } = this;
+    const n = this.norm!;
+    state[at] = c.number(n.count, "normalizer.count", (x) => x >= 0, "a count >= 0");
+    state[at + 1] = c.bool(n.frozen, "normalizer.frozen") ? 1 : 0;
+    c.vector(n.mean, "normalizer.mean", d, "one per input", state, at + 2);
+    c.vector(n.m2, "normalizer.m2", d, "one per input", state, at + 2 + d);
+  }
+
+  private meta(at: number): void {
+    const { c, state, st } = this;
+    state[at] = this.samples;
+    state[at + 1] = c.number(st.weightSum, "state.weightSum", (x) => x >= 0, "a number >= 0");
+    state[at + 2] = this.lambdaEff;
+  }
+
+  private fitStatsSection(at: number): void {
+    const { c, state, m } = this;
+    const f = this.fitStats;
+    state[at] = c.number(f.weight, "state.fitStats.weight", (x) => x >= 0, "a number >= 0");
+    c.vector(f.mean, "state.fitStats.mean", m, "one per output", state, at + 1);
+    c.vector(f.m2, "state.fitStats.m2", m, "one per output", state, at + 1 + m);
+    c.vector(f.sse, "state.fitStats.sse", m, "one per output", state, at + 1 + 2 * m);
+  }
 }
 
 /**
