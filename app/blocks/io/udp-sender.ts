@@ -4,19 +4,17 @@ import {
   defineBlock,
   LegacyParamsError,
   legacyInteger,
+  type BlockContext,
   type InputInfo,
-  type UdpSocketHandle,
 } from "../../engine";
 import { ACTUATION_SIZE, DOAS } from "../control/actuation";
 import { signalInput } from "../shared/inputs";
-import { formatCount, plural, TextThrottle } from "../shared/text";
 import {
   MAX_DATAGRAM_BYTES,
   MAX_STREAMLINED_VALUES,
   RawEncoder,
   StreamlinedEncoder,
   valueSize,
-  type ValueType,
 } from "./udp-format";
 import {
   byteParam,
@@ -25,8 +23,8 @@ import {
   hostParam,
   portParam,
   udpBridge,
-  WarnLimiter,
 } from "./udp-common";
+import { UdpSenderRun, type Lane, type Plan } from "./udp-sender-run";
 
 /** Value types the sender writes (64-bit integers are read by the receiver, not written). */
 const SEND_TYPES = ["f64", "f32", "i8", "i16", "i32", "u8", "u16", "u32"] as const;
@@ -100,14 +98,6 @@ const params = z.strictObject({
 
 type Params = z.output<typeof params>;
 
-interface Plan {
-  serializer: Serializer;
-  type: ValueType;
-  category: number;
-  subcategories: number[];
-  scale: number;
-}
-
 /** A ControlAlgorithm's MOSAIC mapping: its 11 degrees of actuation (app/blocks/control/actuation.ts). */
 function isMosaicActuation(sourceType: string | undefined, size: number): boolean {
   return sourceType === "ControlAlgorithm" && size === ACTUATION_SIZE;
@@ -124,33 +114,7 @@ function plan(
   index = 0,
   inputs = 1,
 ): Plan {
-  const streamlinedOnly = ["Serializer", "ValueType", "Category", "Subcategory", "Subcategories"];
-  if (p.Format !== "streamlined") {
-    for (const k of streamlinedOnly) {
-      const v = p[k as keyof Params];
-      if (v !== undefined && !(k === "Serializer" && (v === "auto" || v === "vector"))) {
-        throw new BlockConfigError(
-          `${k} applies to the streamlined format; Format ${p.Format} sends bare ${p.Format} vectors`,
-          k,
-        );
-      }
-    }
-    const bytes = size * valueSize(p.Format);
-    if (bytes > MAX_DATAGRAM_BYTES) {
-      throw new BlockConfigError(
-        `the input has ${size} values (${bytes} bytes as ${p.Format}), more than one UDP ` +
-          `datagram holds (${MAX_DATAGRAM_BYTES} bytes)`,
-        "Format",
-      );
-    }
-    return {
-      serializer: "vector",
-      type: p.Format,
-      category: 0,
-      subcategories: [],
-      scale: p.Scale ?? 1,
-    };
-  }
+  if (p.Format !== "streamlined") return rawPlan(p, p.Format, size);
   const serializer = p.Serializer === "auto" ? serializerFor(sourceType) : p.Serializer;
   if (serializer !== "control" && p.Subcategories !== undefined) {
     throw new BlockConfigError(
@@ -159,33 +123,11 @@ function plan(
     );
   }
   if (serializer === "control") {
-    let subs: number[];
-    if (p.Subcategories !== undefined) {
-      if (p.Subcategories.length !== size) {
-        throw new BlockConfigError(
-          `Subcategories lists ${p.Subcategories.length} values but the input has ${size}: give one per value`,
-          "Subcategories",
-        );
-      }
-      subs = p.Subcategories;
-    } else if (isMosaicActuation(sourceType, size) && p.Subcategory === undefined) {
-      // The MOSAIC mapping's degrees of actuation, sent with their DOAs codes as the original did.
-      subs = DOAS.map((d) => d.code);
-    } else {
-      const first = p.Subcategory ?? 0;
-      if (first + size - 1 > 255) {
-        throw new BlockConfigError(
-          `values 0…${size - 1} get subcategories ${first}…${first + size - 1}, past 255 (one byte): lower Subcategory or give Subcategories`,
-          "Subcategory",
-        );
-      }
-      subs = Array.from({ length: size }, (_, k) => first + k);
-    }
     return {
       serializer,
       type: p.ValueType ?? "f64",
       category: p.Category ?? 1,
-      subcategories: subs,
+      subcategories: controlSubcategories(p, size, sourceType),
       scale: p.Scale ?? 1,
     };
   }
@@ -206,13 +148,85 @@ function plan(
   };
 }
 
-/** One input's encoder. */
-interface Lane {
-  plan: Plan;
-  size: number;
-  perValue: boolean;
-  sEnc: StreamlinedEncoder | undefined;
-  rEnc: RawEncoder | undefined;
+/** Format f32 / f64: bare vectors, which take none of the streamlined params. */
+function rawPlan(p: Params, format: "f32" | "f64", size: number): Plan {
+  const streamlinedOnly = ["Serializer", "ValueType", "Category", "Subcategory", "Subcategories"];
+  for (const k of streamlinedOnly) {
+    const v = p[k as keyof Params];
+    if (v !== undefined && !(k === "Serializer" && (v === "auto" || v === "vector"))) {
+      throw new BlockConfigError(
+        `${k} applies to the streamlined format; Format ${format} sends bare ${format} vectors`,
+        k,
+      );
+    }
+  }
+  const bytes = size * valueSize(format);
+  if (bytes > MAX_DATAGRAM_BYTES) {
+    throw new BlockConfigError(
+      `the input has ${size} values (${bytes} bytes as ${format}), more than one UDP ` +
+        `datagram holds (${MAX_DATAGRAM_BYTES} bytes)`,
+      "Format",
+    );
+  }
+  return {
+    serializer: "vector",
+    type: format,
+    category: 0,
+    subcategories: [],
+    scale: p.Scale ?? 1,
+  };
+}
+
+/** The control serializer: the subcategory of each of the `size` values. */
+function controlSubcategories(p: Params, size: number, sourceType: string | undefined): number[] {
+  if (p.Subcategories !== undefined) {
+    if (p.Subcategories.length !== size) {
+      throw new BlockConfigError(
+        `Subcategories lists ${p.Subcategories.length} values but the input has ${size}: give one per value`,
+        "Subcategories",
+      );
+    }
+    return p.Subcategories;
+  }
+  if (isMosaicActuation(sourceType, size) && p.Subcategory === undefined) {
+    // The MOSAIC mapping's degrees of actuation, sent with their DOAs codes as the original did.
+    return DOAS.map((d) => d.code);
+  }
+  const first = p.Subcategory ?? 0;
+  if (first + size - 1 > 255) {
+    throw new BlockConfigError(
+      `values 0…${size - 1} get subcategories ${first}…${first + size - 1}, past 255 (one byte): lower Subcategory or give Subcategories`,
+      "Subcategory",
+    );
+  }
+  return Array.from({ length: size }, (_, k) => first + k);
+}
+
+/** Every input's plan and encoder (the plans check the params against the inputs). */
+function lanesFor(ctx: BlockContext, p: Params): Lane[] {
+  const streamlined = p.Format === "streamlined";
+  const n = ctx.inputs.length;
+  return ctx.inputs.map((_, i) => {
+    const input = signalInput(ctx, i);
+    const pl = plan(p, input.size, sourceTypeOf(input.info), i, n);
+    const perValue = pl.serializer === "control";
+    return {
+      plan: pl,
+      size: input.size,
+      perValue,
+      sEnc: streamlined ? new StreamlinedEncoder(perValue ? 1 : input.size, pl.type) : undefined,
+      rEnc: streamlined ? undefined : new RawEncoder(input.size, p.Format as "f32" | "f64"),
+    };
+  });
+}
+
+/** The serializers in use, as the status names them. */
+function lanesText(ctx: BlockContext, p: Params, lanes: Lane[]): string {
+  const laneText = (l: Lane): string =>
+    `${l.plan.serializer} serializer, ${l.plan.type}, category ${l.plan.category}`;
+  if (p.Format !== "streamlined") return `raw ${p.Format}`;
+  if (lanes.length === 1) return laneText(lanes[0]!);
+  return lanes.map((l, i) => `${ctx.inputs[i]!.source}: ${laneText(l)}`).join("; ");
 }
 
 export const UdpSender = defineBlock({
@@ -259,160 +273,15 @@ export const UdpSender = defineBlock({
   views: ["label"],
   panel: "Destination, datagrams sent and send errors.",
   create(ctx, p) {
-    const streamlined = p.Format === "streamlined";
-    const n = ctx.inputs.length;
-    const lanes: Lane[] = ctx.inputs.map((_, i) => {
-      const input = signalInput(ctx, i);
-      const pl = plan(p, input.size, sourceTypeOf(input.info), i, n);
-      const perValue = pl.serializer === "control";
-      return {
-        plan: pl,
-        size: input.size,
-        perValue,
-        sEnc: streamlined ? new StreamlinedEncoder(perValue ? 1 : input.size, pl.type) : undefined,
-        rEnc: streamlined ? undefined : new RawEncoder(input.size, p.Format as "f32" | "f64"),
-      };
-    });
-    /** MOSAIC's one counter over every datagram the block sends. */
-    let counter = 0;
-    const dest = endpointText(p.Host, p.Port);
-    const sendTime = p.Timestamp === "send";
-    const laneText = (l: Lane): string =>
-      `${l.plan.serializer} serializer, ${l.plan.type}, category ${l.plan.category}`;
-    const what = !streamlined
-      ? `raw ${p.Format}`
-      : n === 1
-        ? laneText(lanes[0]!)
-        : lanes.map((l, i) => `${ctx.inputs[i]!.source}: ${laneText(l)}`).join("; ");
-    const warns = new WarnLimiter(ctx);
-    const throttle = new TextThrottle();
-
-    let socket: UdpSocketHandle | undefined;
-    /** Datagrams handed to the socket, and of those (or of datagrams that had no socket) not sent. */
-    let handed = 0;
-    let failed = 0;
-    let notSent = 0;
-    let lastError = "";
-    let unavailable = false;
-    const describe = (): void => {
-      if (unavailable) {
-        ctx.setText(
-          `UDP is unavailable here (the browser build has no network sockets): ${plural(notSent, "event")} not sent`,
-        );
-        return;
-      }
-      const err = failed > 0 ? `, ${formatCount(failed)} not sent (${lastError})` : "";
-      ctx.setText(
-        `→ ${dest} (${what}): ${plural(Math.max(0, handed - failed), "datagram")} sent${err}`,
-      );
+    const lanes = lanesFor(ctx, p);
+    const settings = {
+      host: p.Host,
+      port: p.Port,
+      dest: endpointText(p.Host, p.Port),
+      what: lanesText(ctx, p, lanes),
+      sendTime: p.Timestamp === "send",
+      lanes,
     };
-    const bridge = udpBridge(ctx);
-    if (bridge) describe();
-    else unavailable = true;
-
-    // The bridge calls onError once per datagram it did not send (native-bridges/udp.ts), often
-    // many at once (a queue dropped when a name does not resolve): the text is rebuilt once after
-    // each burst, warnings are rate-limited and say how many datagrams are lost in all.
-    let describeQueued = false;
-    const describeSoon = (): void => {
-      if (describeQueued) return;
-      describeQueued = true;
-      queueMicrotask(() => {
-        describeQueued = false;
-        describe();
-      });
-    };
-    const onError = (message: string): void => {
-      failed++;
-      lastError = message;
-      warns.warn(`UDP to ${dest}: ${message} (${plural(failed, "datagram")} not sent so far)`);
-      describeSoon();
-    };
-    /** Datagrams one event of input `port` makes. */
-    const perEvent = (port: number): number => {
-      const l = lanes[port]!;
-      return l.perValue ? l.size : 1;
-    };
-
-    const close = (): void => {
-      const s = socket;
-      socket = undefined;
-      s?.close();
-    };
-
-    return {
-      start() {
-        if (!bridge) {
-          ctx.warn(
-            "UDP is unavailable here (the browser build has no network sockets): this block sends nothing",
-          );
-          return;
-        }
-        if (socket) return;
-        try {
-          socket = bridge.open({ remote: { host: p.Host, port: p.Port }, onError });
-        } catch (e) {
-          onError(e instanceof Error ? e.message : String(e));
-        }
-      },
-      process(f, port) {
-        const s = socket;
-        const n = f.n;
-        if (!s) {
-          if (unavailable) notSent += n;
-          else if (n > 0) {
-            // Before start or after a socket that could not be opened: counted as not sent.
-            const d = n * perEvent(port);
-            handed += d;
-            failed += d;
-            lastError ||= "no socket";
-          }
-          if (n > 0 && throttle.due(f.t[n - 1]!)) describe();
-          return;
-        }
-        const lane = lanes[port]!;
-        const { rEnc, sEnc, size } = lane;
-        const { category, subcategories: subs, scale } = lane.plan;
-        if (sEnc) sEnc.counter = counter;
-        const v = f.v;
-        const stride = f.stride;
-        for (let e = 0; e < n; e++) {
-          const off = e * stride;
-          if (rEnc) {
-            s.send(rEnc.encode(v, off, scale));
-            handed++;
-          } else if (lane.perValue) {
-            const t = sendTime ? ctx.now() : f.t[e]!;
-            for (let k = 0; k < size; k++) {
-              s.send(sEnc!.encode(t, category, subs[k]!, v, off + k, scale));
-              handed++;
-            }
-          } else {
-            const t = sendTime ? ctx.now() : f.t[e]!;
-            s.send(sEnc!.encode(t, category, subs[0]!, v, off, scale));
-            handed++;
-          }
-        }
-        if (sEnc) counter = sEnc.counter;
-        if (n > 0 && throttle.due(f.t[n - 1]!)) describe();
-      },
-      stop() {
-        close();
-        describe();
-      },
-      reset() {
-        counter = 0;
-        handed = 0;
-        failed = 0;
-        notSent = 0;
-        lastError = "";
-        throttle.reset();
-        warns.reset();
-        describe();
-      },
-      dispose() {
-        close();
-      },
-    };
+    return new UdpSenderRun(ctx, settings, udpBridge(ctx)).instance();
   },
 });
