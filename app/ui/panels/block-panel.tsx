@@ -6,28 +6,28 @@
  * unwatches its outputs and leaves no animation frame or observer behind. Telemetry (sent anyway)
  * is recorded for the Status tab as long as the panel exists.
  */
-import {
-  useCallback,
-  useEffect,
-  useId,
-  useMemo,
-  useState,
-  type KeyboardEvent,
-  type ReactNode,
-} from "react";
+import { useCallback, useEffect, useState, type KeyboardEvent, type ReactNode } from "react";
 import type { BlockInfo } from "../../engine/protocol";
 import { useUi } from "../app/ui-context";
 import { useEngine, useEngineState, useLiveBlock } from "../client/hooks";
-import { restoreSettings, type PanelView } from "../app/panel-layouts";
+import type { PanelView } from "../app/panel-layouts";
 import { useReportView } from "../app/use-panel-layouts";
 import { ParamsForm, type SetResult } from "../forms/params-form";
-import { HEATMAP_DEFAULTS, Heatmap, type HeatmapSettings } from "./heatmap";
+import { Heatmap } from "./heatmap";
 import { LabelDisplay } from "./labels";
 import { PlayerView } from "./player-view";
-import { SCOPE_DEFAULTS, Scope, type ScopeSettings } from "./scope";
-import { SPIDER_DEFAULTS, SpiderPlot, type SpiderSettings } from "./spider";
-import { StatusView, useStatusRecorder } from "./status";
+import { Scope } from "./scope";
+import { SpiderPlot } from "./spider";
+import { StatusView, useStatusRecorder, type StatusRecorder } from "./status";
 import { TrainingView } from "./training-view";
+import { DATA_VIEWS, TAB_TITLE, usePanelTabs, type PanelTabs, type Tab } from "./use-panel-tabs";
+import {
+  usePanelOutput,
+  useViewSettings,
+  type PanelOutput,
+  type PatchSettings,
+  type ViewSettings,
+} from "./use-panel-view";
 import type { OutputInfo } from "./view-props";
 import "./panels.css";
 
@@ -46,27 +46,6 @@ export interface BlockPanelProps {
   onView?: (view: PanelView) => void;
 }
 
-type DataView = "scope" | "spider" | "heatmap" | "label" | "training" | "player";
-type Tab = DataView | "params" | "status";
-
-const TAB_TITLE: Record<Tab, string> = {
-  scope: "Scope",
-  spider: "Spider",
-  heatmap: "Heatmap",
-  label: "Labels",
-  training: "Training",
-  player: "Player",
-  params: "Params",
-  status: "Status",
-};
-const DATA_VIEWS: readonly string[] = ["scope", "spider", "heatmap", "label", "training", "player"];
-
-interface Settings {
-  scope: ScopeSettings;
-  spider: SpiderSettings;
-  heatmap: HeatmapSettings;
-}
-
 export function BlockPanel({
   block,
   visible,
@@ -79,128 +58,20 @@ export function BlockPanel({
   const client = useEngine();
   const engineState = useEngineState();
   const recorder = useStatusRecorder(block.name);
-  const tabs = useMemo<Tab[]>(
-    () => [
-      ...(block.views.filter((v) => DATA_VIEWS.includes(v)) as DataView[]),
-      "params",
-      "status",
-    ],
-    [block.views],
-  );
-  const [chosen, setTab] = useState<Tab>(() => (view?.tab as Tab | undefined) ?? tabs[0]!);
-  const tab = tabs.includes(chosen) ? chosen : tabs[0]!;
-  // Outputs with values (timers' ticks carry none).
-  const outputs = block.outputs as OutputInfo[];
-  const valued = outputs.filter((o) => o.shape.rows * o.shape.cols > 0);
-  const [portName, setPort] = useState<string | undefined>(view?.port ?? valued[0]?.name);
-  const output = valued.find((o) => o.name === portName) ?? valued[0];
-  const [settings, setSettings] = useState<Settings>(() => ({
-    scope: restoreSettings(SCOPE_DEFAULTS, view?.settings?.scope),
-    spider: restoreSettings(SPIDER_DEFAULTS, view?.settings?.spider),
-    heatmap: restoreSettings(HEATMAP_DEFAULTS, view?.settings?.heatmap),
-  }));
-  useReportView(onView, tab, output?.name, settings);
-  const patch = useCallback(
-    <K extends keyof Settings>(k: K) =>
-      (p: Partial<Settings[K]>) =>
-        setSettings((s) => ({ ...s, [k]: { ...s[k], ...p } })),
-    [],
-  );
+  const tabs = usePanelTabs(block.views, view?.tab);
+  const out = usePanelOutput(block, view);
+  const { settings, patch } = useViewSettings(view);
+  useReportView(onView, tabs.tab, out.output?.name, settings);
   const onSet = useCallback(
     (param: string, value: unknown) => client.setParam(block.name, param, value),
     [client, block.name],
   );
-  const hasStimulus = block.views.includes("stimulus");
-  const base = useId();
-  const onTabKey = (e: KeyboardEvent<HTMLDivElement>): void => {
-    const i = tabs.indexOf(tab);
-    const next =
-      e.key === "ArrowRight"
-        ? i + 1
-        : e.key === "ArrowLeft"
-          ? i - 1
-          : e.key === "Home"
-            ? 0
-            : e.key === "End"
-              ? tabs.length - 1
-              : -2;
-    if (next === -2) return;
-    e.preventDefault();
-    const t = tabs[(next + tabs.length) % tabs.length]!;
-    setTab(t);
-    document.getElementById(`${base}-tab-${t}`)?.focus();
-  };
   const onKey = (e: KeyboardEvent<HTMLElement>): void => {
     const el = e.target as HTMLElement;
     if (e.key === "Escape" && onClose && !el.closest("input, select, textarea, [role=tablist]"))
       onClose();
   };
-
-  const isData = DATA_VIEWS.includes(tab);
-  const tools =
-    valued.length > 1 && output ? (
-      <label className="mp-field mp-port">
-        Output
-        <select value={output.name} onChange={(e) => setPort(e.target.value)}>
-          {valued.map((o) => (
-            <option key={o.name} value={o.name}>
-              {o.name} [{o.shape.rows}, {o.shape.cols}]
-            </option>
-          ))}
-        </select>
-      </label>
-    ) : undefined;
-  const active = visible && isData;
-  let body: ReactNode;
-  if (tab === "params") {
-    body = <LiveParamsForm block={block} onSet={onSet} onEditStatic={onEditStatic} />;
-  } else if (tab === "status") {
-    body = <StatusView block={block} recorder={recorder} active={visible} />;
-  } else if (tab === "label") {
-    body = <LabelDisplay block={block} active={active} />;
-  } else if (tab === "training") {
-    body = <TrainingView block={block} active={active} />;
-  } else if (tab === "player") {
-    body = <PlayerView block={block} active={active} />;
-  } else if (!output) {
-    body = <p className="mp-muted">{block.name} has no output with values to show.</p>;
-  } else if (tab === "scope") {
-    body = (
-      <Scope
-        key={output.name}
-        tools={tools}
-        block={block}
-        output={output}
-        active={active}
-        settings={settings.scope}
-        onSettings={patch("scope")}
-      />
-    );
-  } else if (tab === "spider") {
-    body = (
-      <SpiderPlot
-        key={output.name}
-        tools={tools}
-        block={block}
-        output={output}
-        active={active}
-        settings={settings.spider}
-        onSettings={patch("spider")}
-      />
-    );
-  } else {
-    body = (
-      <Heatmap
-        key={output.name}
-        tools={tools}
-        block={block}
-        output={output}
-        active={active}
-        settings={settings.heatmap}
-        onSettings={patch("heatmap")}
-      />
-    );
-  }
+  const { base, tab } = tabs;
 
   return (
     <div
@@ -210,52 +81,155 @@ export function BlockPanel({
       onKeyDown={onKey}
     >
       <p className="mp-summary">{block.summary}</p>
-      <div className="mp-tabbar">
-        <div
-          className="mp-tabs"
-          role="tablist"
-          aria-label={`${block.name} views`}
-          onKeyDown={onTabKey}
-        >
-          {tabs.map((t) => (
-            <button
-              key={t}
-              id={`${base}-tab-${t}`}
-              type="button"
-              role="tab"
-              className="mp-tab"
-              aria-selected={t === tab}
-              aria-controls={`${base}-panel`}
-              tabIndex={t === tab ? 0 : -1}
-              data-tab={t}
-              onClick={() => setTab(t)}
-            >
-              {TAB_TITLE[t]}
-            </button>
-          ))}
-        </div>
-        {hasStimulus && (
-          <button
-            type="button"
-            className="mp-btn mp-stimulus-btn"
-            onClick={onOpenStimulus}
-            disabled={!onOpenStimulus}
-            title="Open the participant-facing Stimulus view"
-          >
-            Stimulus view ↗
-          </button>
-        )}
-      </div>
+      <PanelTabBar block={block} tabs={tabs} onOpenStimulus={onOpenStimulus} />
       <div
         id={`${base}-panel`}
         role="tabpanel"
         aria-labelledby={`${base}-tab-${tab}`}
         className="mp-tabpanel"
       >
-        {body}
+        <PanelBody
+          block={block}
+          tab={tab}
+          visible={visible}
+          out={out}
+          settings={settings}
+          patch={patch}
+          recorder={recorder}
+          onSet={onSet}
+          onEditStatic={onEditStatic}
+        />
       </div>
       <Actions block={block} loaded={engineState !== "empty"} />
     </div>
+  );
+}
+
+/** The tabs and, for a block with a "stimulus" view, the button that opens it. */
+function PanelTabBar({
+  block,
+  tabs: { tabs, tab, setTab, base, onTabKey },
+  onOpenStimulus,
+}: {
+  block: BlockInfo;
+  tabs: PanelTabs;
+  onOpenStimulus: (() => void) | undefined;
+}): ReactNode {
+  const hasStimulus = block.views.includes("stimulus");
+  return (
+    <div className="mp-tabbar">
+      <div
+        className="mp-tabs"
+        role="tablist"
+        aria-label={`${block.name} views`}
+        onKeyDown={onTabKey}
+      >
+        {tabs.map((t) => (
+          <button
+            key={t}
+            id={`${base}-tab-${t}`}
+            type="button"
+            role="tab"
+            className="mp-tab"
+            aria-selected={t === tab}
+            aria-controls={`${base}-panel`}
+            tabIndex={t === tab ? 0 : -1}
+            data-tab={t}
+            onClick={() => setTab(t)}
+          >
+            {TAB_TITLE[t]}
+          </button>
+        ))}
+      </div>
+      {hasStimulus && (
+        <button
+          type="button"
+          className="mp-btn mp-stimulus-btn"
+          onClick={onOpenStimulus}
+          disabled={!onOpenStimulus}
+          title="Open the participant-facing Stimulus view"
+        >
+          Stimulus view ↗
+        </button>
+      )}
+    </div>
+  );
+}
+
+/** The output picker shown in a plot's toolbar when the block has several outputs with values. */
+function OutputPicker({
+  valued,
+  output,
+  setPort,
+}: {
+  valued: readonly OutputInfo[];
+  output: OutputInfo;
+  setPort: (name: string) => void;
+}): ReactNode {
+  return (
+    <label className="mp-field mp-port">
+      Output
+      <select value={output.name} onChange={(e) => setPort(e.target.value)}>
+        {valued.map((o) => (
+          <option key={o.name} value={o.name}>
+            {o.name} [{o.shape.rows}, {o.shape.cols}]
+          </option>
+        ))}
+      </select>
+    </label>
+  );
+}
+
+interface PanelBodyProps {
+  block: BlockInfo;
+  tab: Tab;
+  visible: boolean;
+  out: PanelOutput;
+  settings: ViewSettings;
+  patch: PatchSettings;
+  recorder: StatusRecorder;
+  onSet: (param: string, value: unknown) => Promise<SetResult>;
+  onEditStatic: ((param: string, value: unknown) => Promise<SetResult>) | undefined;
+}
+
+/** The open tab's content; a data view gets data only while the panel is visible. */
+function PanelBody(props: PanelBodyProps): ReactNode {
+  const { block, tab, visible, settings, patch } = props;
+  const { valued, output, setPort } = props.out;
+  const active = visible && DATA_VIEWS.includes(tab);
+  if (tab === "params")
+    return <LiveParamsForm block={block} onSet={props.onSet} onEditStatic={props.onEditStatic} />;
+  if (tab === "status")
+    return <StatusView block={block} recorder={props.recorder} active={visible} />;
+  if (tab === "label") return <LabelDisplay block={block} active={active} />;
+  if (tab === "training") return <TrainingView block={block} active={active} />;
+  if (tab === "player") return <PlayerView block={block} active={active} />;
+  if (!output) return <p className="mp-muted">{block.name} has no output with values to show.</p>;
+  const tools =
+    valued.length > 1 ? (
+      <OutputPicker valued={valued} output={output} setPort={setPort} />
+    ) : undefined;
+  const common = { tools, block, output, active };
+  if (tab === "scope")
+    return (
+      <Scope key={output.name} {...common} settings={settings.scope} onSettings={patch("scope")} />
+    );
+  if (tab === "spider")
+    return (
+      <SpiderPlot
+        key={output.name}
+        {...common}
+        settings={settings.spider}
+        onSettings={patch("spider")}
+      />
+    );
+  return (
+    <Heatmap
+      key={output.name}
+      {...common}
+      settings={settings.heatmap}
+      onSettings={patch("heatmap")}
+    />
   );
 }
 
