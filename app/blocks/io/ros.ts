@@ -2,28 +2,15 @@ import { z } from "zod";
 import {
   BlockConfigError,
   defineBlock,
-  errorMessage,
   legacyInteger,
   LegacyParamsError,
   vectorShape,
-  type OutputPort,
-  type RosBridge,
-  type RosConnection,
-  type RosConnectionState,
-  type RosPublisher,
-  type RosSubscription,
+  type BlockContext,
 } from "../../engine";
 import { signalInput } from "../shared/inputs";
-import { formatCount, plural, TextThrottle } from "../shared/text";
-import {
-  fixedSizeOf,
-  ROS_MESSAGE_TYPES,
-  rosDecoder,
-  rosEncoder,
-  type RosDecoder,
-  type RosEncoder,
-} from "./ros-messages";
-import { WarnLimiter } from "./udp-common";
+import type { RosLinkOptions } from "./ros-link";
+import { fixedSizeOf, ROS_MESSAGE_TYPES, rosDecoder, rosEncoder } from "./ros-messages";
+import { RosRun, type RosSide } from "./ros-run";
 
 /** A ROS graph resource name: `/a/b_c`, `a`, `~/private` (no `//`, no trailing `/`). */
 const TOPIC_NAME = /^(~\/|\/)?[A-Za-z_][A-Za-z0-9_]*(\/[A-Za-z_][A-Za-z0-9_]*)*$/;
@@ -120,10 +107,6 @@ const params = z.strictObject({
 
 type Params = z.output<typeof params>;
 
-/** "0.3 s", "12 s". */
-const seconds = (s: number): string =>
-  s < 1 ? `${Math.max(0.1, Math.ceil(s * 10) / 10)} s` : `${Math.ceil(s - 1e-9)} s`;
-
 function checkParams(p: Params): void {
   const publish = p.Direction === "publish";
   const sub = ["ThrottleMs", "QueueLength"] as const;
@@ -154,6 +137,83 @@ function checkParams(p: Params): void {
       "ReconnectMaxSeconds",
     );
   }
+}
+
+/** Direction publish: the input's width, checked against the message type and Channels. */
+function publishSide(ctx: BlockContext, p: Params): RosSide {
+  const type = p.MessageType;
+  const fixed = fixedSizeOf(type);
+  if (ctx.inputs.length === 0) {
+    throw new BlockConfigError(
+      "Direction publish needs an input (the values to publish); to receive messages set Direction: subscribe",
+      "Direction",
+    );
+  }
+  const input = signalInput(ctx, 0);
+  const size = input.size;
+  if (fixed !== undefined && size !== fixed) {
+    throw new BlockConfigError(
+      `a ${type} message carries ${fixed} value${fixed === 1 ? "" : "s"}, but the input '${input.info.source}' has ${size}`,
+      "MessageType",
+    );
+  }
+  if (p.Channels !== undefined && p.Channels !== size) {
+    throw new BlockConfigError(
+      `Channels is ${p.Channels} but the input '${input.info.source}' carries ${size} values per event`,
+      "Channels",
+    );
+  }
+  const encoder = rosEncoder(type, {
+    size,
+    rows: input.shape.rows,
+    cols: input.shape.cols,
+    ...(p.JointNames ? { jointNames: p.JointNames } : {}),
+  });
+  return { publish: true, size, encoder };
+}
+
+/** Direction subscribe: the width of the output from Channels, the message type or JointNames. */
+function subscribeSide(ctx: BlockContext, p: Params): RosSide {
+  const type = p.MessageType;
+  const fixed = fixedSizeOf(type);
+  if (ctx.inputs.length > 0) {
+    throw new BlockConfigError(
+      "Direction subscribe takes no input (it emits the messages of Topic); to send the input set Direction: publish",
+      "Direction",
+    );
+  }
+  if (fixed !== undefined && p.Channels !== undefined && p.Channels !== fixed) {
+    throw new BlockConfigError(
+      `a ${type} message carries ${fixed} value${fixed === 1 ? "" : "s"}, not Channels ${p.Channels}`,
+      "Channels",
+    );
+  }
+  const size = p.Channels ?? fixed ?? p.JointNames?.length;
+  if (size === undefined) {
+    throw new BlockConfigError(
+      `Channels is needed to subscribe to ${type} (the values per message: the width of the output)`,
+      "Channels",
+    );
+  }
+  const decoder = rosDecoder(type, {
+    size,
+    ...(p.JointNames ? { jointNames: p.JointNames } : {}),
+  });
+  return { publish: false, size, decoder, out: ctx.output(vectorShape(size)) };
+}
+
+function linkOptions(p: Params): RosLinkOptions {
+  return {
+    url: p.Url,
+    topic: p.Topic,
+    type: p.MessageType,
+    publish: p.Direction === "publish",
+    latch: p.Latch,
+    throttleMs: p.ThrottleMs,
+    queueLength: p.QueueLength,
+    reconnectSeconds: p.ReconnectSeconds,
+    reconnectMaxSeconds: p.ReconnectMaxSeconds,
+  };
 }
 
 export const Ros = defineBlock({
@@ -231,354 +291,13 @@ export const Ros = defineBlock({
   panel: "Connection state, messages in and out, the reconnect countdown; received values.",
   create(ctx, p) {
     checkParams(p);
-    const publish = p.Direction === "publish";
-    const type = p.MessageType;
-    const fixed = fixedSizeOf(type);
-    let size: number;
-    let encoder: RosEncoder | undefined;
-    let decoder: RosDecoder | undefined;
-    let out: OutputPort | undefined;
-    if (publish) {
-      if (ctx.inputs.length === 0) {
-        throw new BlockConfigError(
-          "Direction publish needs an input (the values to publish); to receive messages set Direction: subscribe",
-          "Direction",
-        );
-      }
-      const input = signalInput(ctx, 0);
-      size = input.size;
-      if (fixed !== undefined && size !== fixed) {
-        throw new BlockConfigError(
-          `a ${type} message carries ${fixed} value${fixed === 1 ? "" : "s"}, but the input '${input.info.source}' has ${size}`,
-          "MessageType",
-        );
-      }
-      if (p.Channels !== undefined && p.Channels !== size) {
-        throw new BlockConfigError(
-          `Channels is ${p.Channels} but the input '${input.info.source}' carries ${size} values per event`,
-          "Channels",
-        );
-      }
-      encoder = rosEncoder(type, {
-        size,
-        rows: input.shape.rows,
-        cols: input.shape.cols,
-        ...(p.JointNames ? { jointNames: p.JointNames } : {}),
-      });
-    } else {
-      if (ctx.inputs.length > 0) {
-        throw new BlockConfigError(
-          "Direction subscribe takes no input (it emits the messages of Topic); to send the input set Direction: publish",
-          "Direction",
-        );
-      }
-      if (fixed !== undefined && p.Channels !== undefined && p.Channels !== fixed) {
-        throw new BlockConfigError(
-          `a ${type} message carries ${fixed} value${fixed === 1 ? "" : "s"}, not Channels ${p.Channels}`,
-          "Channels",
-        );
-      }
-      const n = p.Channels ?? fixed ?? p.JointNames?.length;
-      if (n === undefined) {
-        throw new BlockConfigError(
-          `Channels is needed to subscribe to ${type} (the values per message: the width of the output)`,
-          "Channels",
-        );
-      }
-      size = n;
-      decoder = rosDecoder(type, {
-        size,
-        ...(p.JointNames ? { jointNames: p.JointNames } : {}),
-      });
-      out = ctx.output(vectorShape(size));
-    }
-    if (p.JointNames !== undefined && p.JointNames.length !== size) {
+    const side = p.Direction === "publish" ? publishSide(ctx, p) : subscribeSide(ctx, p);
+    if (p.JointNames !== undefined && p.JointNames.length !== side.size) {
       throw new BlockConfigError(
-        `JointNames lists ${p.JointNames.length} joints for ${size} values: give one name per value`,
+        `JointNames lists ${p.JointNames.length} joints for ${side.size} values: give one name per value`,
         "JointNames",
       );
     }
-
-    const url = p.Url;
-    const topic = p.Topic;
-    const bridge: RosBridge | undefined = ctx.io.ros;
-    const warns = new WarnLimiter(ctx);
-    const throttle = new TextThrottle();
-    const scratch = new Float64Array(size);
-
-    type State = "idle" | "unavailable" | "connecting" | "connected" | "waiting" | "stopped";
-    let state: State = bridge ? "idle" : "unavailable";
-    let conn: RosConnection | undefined;
-    let pub: RosPublisher | undefined;
-    let sub: RosSubscription | undefined;
-    /** Each connection attempt gets a number; callbacks of older attempts are ignored. */
-    let attempt = 0;
-    let running = false;
-    let reason = "";
-    /** Failed attempts (or lost connections) since the last successful connection. */
-    let failures = 0;
-    let connections = 0;
-    let retryAt = Infinity;
-    let sent = 0;
-    let received = 0;
-    let dropped = 0;
-    let skipped = 0;
-    let malformed = 0;
-    let lastMalformed = "";
-    let lastText = "";
-
-    const describe = (): void => {
-      let text: string;
-      if (state === "unavailable") {
-        text =
-          "ROS is unavailable here (the browser build has no rosbridge connection): run the " +
-          "pipeline with the desktop app or `mosaic run`";
-        if (dropped > 0) text += ` · ${formatCount(dropped)} not sent`;
-        if (text !== lastText) ctx.setText((lastText = text));
-        return;
-      }
-      const what = `${publish ? "publishing" : "subscribed to"} ${topic} (${type})`;
-      switch (state) {
-        case "idle":
-          text = `${url} · ${what}`;
-          break;
-        case "connecting":
-          text = `connecting to ${url}${failures > 0 ? ` (attempt ${failures + 1})` : ""}… · ${what}`;
-          break;
-        case "connected":
-          text = `connected to ${url} · ${what}`;
-          break;
-        case "waiting": {
-          const wait =
-            retryAt === Infinity
-              ? "not reconnecting (ReconnectSeconds 0)"
-              : `reconnecting in ${seconds(retryAt - ctx.now())} (attempt ${failures + 1})`;
-          text = `disconnected from ${url}: ${reason}; ${wait} · ${what}`;
-          break;
-        }
-        case "stopped":
-          text = `stopped · ${what}`;
-          break;
-      }
-      text += publish ? ` · ${formatCount(sent)} out` : ` · ${formatCount(received)} in`;
-      if (connections > 1) text += ` · ${plural(connections - 1, "reconnect")}`;
-      if (dropped > 0) text += ` · ${formatCount(dropped)} dropped while disconnected`;
-      if (skipped > 0) text += ` · ${formatCount(skipped)} not sent (NaN or ±∞)`;
-      if (malformed > 0) text += ` · ${formatCount(malformed)} malformed (last: ${lastMalformed})`;
-      if (text !== lastText) ctx.setText((lastText = text));
-    };
-    describe();
-
-    const closeConnection = (): void => {
-      const c = conn;
-      const s = sub;
-      const pb = pub;
-      conn = undefined;
-      sub = undefined;
-      pub = undefined;
-      try {
-        s?.unsubscribe();
-        pb?.unadvertise();
-        c?.close();
-      } catch (e) {
-        warns.warn(`closing the connection to ${url}: ${errorMessage(e)}`);
-      }
-    };
-
-    const onMessage = (msg: unknown): void => {
-      if (!running || !out || !decoder) return;
-      const now = ctx.now();
-      const err = decoder.decode(msg, scratch);
-      if (err !== undefined) {
-        malformed++;
-        lastMalformed = err;
-        warns.warn(`malformed ${type} message on ${topic}: ${err} (${malformed} so far)`);
-        describe();
-        return;
-      }
-      const f = out.frame(1);
-      f.t[0] = now;
-      f.v.set(scratch);
-      received++;
-      out.emit(f);
-      if (throttle.due(now)) describe();
-    };
-
-    /** The one-shot: refreshes the countdown every second and reconnects when it is due. */
-    const countdown = (): void => {
-      if (!running || state !== "waiting") return;
-      const now = ctx.now();
-      if (now >= retryAt - 1e-6) {
-        connect();
-        return;
-      }
-      describe();
-      ctx.at(Math.min(retryAt, now + 1), countdown);
-    };
-
-    const lost = (message: string): void => {
-      const wasConnected = state === "connected";
-      closeConnection();
-      reason = message;
-      failures++;
-      state = "waiting";
-      if (p.ReconnectSeconds > 0) {
-        const wait = Math.min(p.ReconnectMaxSeconds, p.ReconnectSeconds * 2 ** (failures - 1));
-        retryAt = ctx.now() + wait;
-        ctx.at(Math.min(retryAt, ctx.now() + 1), countdown);
-      } else {
-        retryAt = Infinity;
-      }
-      if (wasConnected) warns.warn(`lost the connection to rosbridge at ${url}: ${message}`);
-      else if (failures === 1) warns.warn(`cannot connect to rosbridge at ${url}: ${message}`);
-      describe();
-    };
-
-    const connect = (): void => {
-      if (!bridge) return;
-      const id = ++attempt;
-      const current = (): boolean => id === attempt && running;
-      state = "connecting";
-      describe();
-      const onState = (s: RosConnectionState, message?: string): void => {
-        if (!current()) return;
-        if (s === "connecting") {
-          state = "connecting";
-        } else if (s === "connected") {
-          state = "connected";
-          failures = 0;
-          connections++;
-          reason = "";
-        } else {
-          lost(message ?? "closed");
-          return;
-        }
-        describe();
-      };
-      let c: RosConnection;
-      try {
-        c = bridge.connect({
-          url,
-          onState,
-          onNotice: (m) => {
-            if (current()) warns.warn(`rosbridge ${url} (${topic}): ${m}`);
-          },
-        });
-      } catch (e) {
-        lost(errorMessage(e));
-        return;
-      }
-      if (!current() || (state as State) === "waiting") {
-        // Refused at once (through onState): this attempt is over.
-        try {
-          c.close();
-        } catch {
-          // nothing to close
-        }
-        return;
-      }
-      conn = c;
-      try {
-        if (publish) {
-          pub = c.advertise({
-            topic,
-            type,
-            ...(p.Latch !== undefined ? { latch: p.Latch } : {}),
-          });
-        } else {
-          sub = c.subscribe({
-            topic,
-            type,
-            ...(p.ThrottleMs !== undefined ? { throttleMs: p.ThrottleMs } : {}),
-            ...(p.QueueLength !== undefined ? { queueLength: p.QueueLength } : {}),
-            onMessage,
-          });
-        }
-      } catch (e) {
-        if (current()) lost(errorMessage(e));
-      }
-    };
-
-    return {
-      start() {
-        if (!bridge) {
-          ctx.warn(
-            "ROS is unavailable here (the browser build has no rosbridge connection): this block " +
-              (publish ? "sends nothing" : "receives nothing"),
-          );
-          describe();
-          return;
-        }
-        if (running) return;
-        running = true;
-        failures = 0;
-        connect();
-      },
-      process(f) {
-        const n = f.n;
-        if (n === 0 || !encoder) return;
-        const v = f.v;
-        const stride = f.stride;
-        const p0 = pub;
-        const live = p0 !== undefined && state === "connected";
-        for (let e = 0; e < n; e++) {
-          const off = e * stride;
-          if (!live) {
-            dropped++;
-            continue;
-          }
-          let finite = true;
-          for (let k = 0; k < size; k++) {
-            if (!Number.isFinite(v[off + k]!)) {
-              finite = false;
-              break;
-            }
-          }
-          if (!finite) {
-            skipped++;
-            continue;
-          }
-          if (p0.publish(encoder.encode(v, off))) sent++;
-          else dropped++;
-        }
-        if (throttle.due(f.t[n - 1]!)) describe();
-      },
-      stop() {
-        running = false;
-        attempt++;
-        closeConnection();
-        if (state !== "unavailable") state = "stopped";
-        retryAt = Infinity;
-        describe();
-      },
-      reset() {
-        sent = 0;
-        received = 0;
-        dropped = 0;
-        skipped = 0;
-        malformed = 0;
-        lastMalformed = "";
-        connections = state === "connected" ? 1 : 0;
-        throttle.reset();
-        warns.reset();
-        describe();
-      },
-      dispose() {
-        running = false;
-        attempt++;
-        closeConnection();
-      },
-      actions: {
-        counts: {
-          label: "Counts",
-          description:
-            "Messages sent or received, dropped while disconnected, malformed, reconnects",
-          run: () =>
-            `${state}: ${sent} sent, ${received} received, ${dropped} dropped while disconnected, ` +
-            `${skipped} not sent (NaN or ±∞), ${malformed} malformed` +
-            `${lastMalformed ? ` (last: ${lastMalformed})` : ""}, ${Math.max(0, connections - 1)} reconnects`,
-        },
-      },
-    };
+    return new RosRun(ctx, side, linkOptions(p)).instance();
   },
 });
