@@ -1,16 +1,8 @@
 import { z } from "zod";
-import {
-  defineBlock,
-  LegacyParamsError,
-  legacyInteger,
-  vectorShape,
-  type Endpoint,
-  type UdpSocketHandle,
-} from "../../engine";
+import { defineBlock, LegacyParamsError, legacyInteger, vectorShape } from "../../engine";
 import { timerInput } from "../shared/inputs";
-import { plural, TextThrottle } from "../shared/text";
-import { decodeHannesEmg } from "./hannes-protocol";
-import { endpointText, portParam, udpBridge, WarnLimiter } from "./udp-common";
+import { HannesReceiverRun } from "./hannes-receiver-run";
+import { portParam, udpBridge } from "./udp-common";
 
 const params = z.strictObject({
   Port: portParam("The UDP port to listen on (the original listened on every address)"),
@@ -81,150 +73,14 @@ export const HannesReceiver = defineBlock({
   create(ctx, p) {
     const paced = ctx.inputs.length > 0;
     if (paced) timerInput(ctx, 0);
-    const C = p.Channels;
-    const out = ctx.output(vectorShape(C));
-    const where = endpointText(p.Host, p.Port);
-    const warns = new WarnLimiter(ctx);
-    const throttle = new TextThrottle();
-    // FIFO of samples waiting for ticks (paced only).
-    const cap = p.MaxDelay;
-    const fifo = new Float64Array(cap * C);
-    let head = 0;
-    let count = 0;
-    const last = new Float64Array(C);
-    const scratch = new Float64Array(C);
-    let datagrams = 0;
-    let malformed = 0;
-    let dropped = 0;
-    let repeated = 0;
-    let failure = "";
-    let listening = false;
-    let socket: UdpSocketHandle | undefined;
-
-    const describe = (): void => {
-      if (failure !== "") {
-        ctx.setText(failure);
-        return;
-      }
-      const parts = [
-        `${listening ? "listening on" : "opening"} ${where}`,
-        plural(datagrams, "datagram"),
-      ];
-      if (dropped > 0) parts.push(`${dropped} dropped (MaxDelay)`);
-      if (repeated > 0) parts.push(`${repeated} ticks without a new sample`);
-      if (malformed > 0) parts.push(`${malformed} malformed`);
-      ctx.setText(parts.join(", "));
-    };
-    const bridge = udpBridge(ctx);
-    if (bridge) describe();
-
-    const onMessage = (data: Uint8Array, from: Endpoint): void => {
-      datagrams++;
-      if (!decodeHannesEmg(data, C, scratch)) {
-        malformed++;
-        warns.warn(
-          `malformed datagram from ${endpointText(from.host, from.port)} on ${where}: ${data.length} bytes, ` +
-            `${2 + 2 * C} needed for ${C} channels`,
-        );
-        describe();
-        return;
-      }
-      if (!paced) {
-        const f = out.frame(1);
-        f.t[0] = ctx.now();
-        f.v.set(scratch);
-        last.set(scratch);
-        out.emit(f);
-        return;
-      }
-      if (count === cap) {
-        // Drop the oldest: keep the MaxDelay newest.
-        head = (head + 1) % cap;
-        count--;
-        dropped++;
-      }
-      fifo.set(scratch, ((head + count) % cap) * C);
-      count++;
-    };
-
-    const onError = (message: string): void => {
-      if (!listening) {
-        failure = `cannot listen on UDP ${where}: ${message}`;
-        const s = socket;
-        socket = undefined;
-        s?.close();
-      }
-      warns.warn(listening ? `UDP ${where}: ${message}` : failure);
-      describe();
-    };
-
-    return {
-      start() {
-        if (!bridge) {
-          ctx.warn(
-            "UDP is unavailable here (the browser build has no network sockets): this block receives nothing",
-          );
-          return;
-        }
-        if (socket) return;
-        failure = "";
-        try {
-          const s = bridge.open({
-            bind: { host: p.Host, port: p.Port },
-            onMessage,
-            onReady: () => {
-              listening = true;
-              describe();
-            },
-            onError,
-          });
-          if (failure === "") socket = s;
-          else s.close();
-        } catch (e) {
-          onError(e instanceof Error ? e.message : String(e));
-        }
-      },
-      process(f) {
-        const n = f.n;
-        if (n === 0) return;
-        const o = out.frame(n);
-        for (let e = 0; e < n; e++) {
-          o.t[e] = f.t[e]!;
-          if (count > 0) {
-            last.set(fifo.subarray(head * C, (head + 1) * C));
-            head = (head + 1) % cap;
-            count--;
-          } else {
-            repeated++;
-          }
-          o.v.set(last, e * C);
-        }
-        out.emit(o);
-        if (throttle.due(f.t[n - 1]!)) describe();
-      },
-      stop() {
-        const s = socket;
-        socket = undefined;
-        listening = false;
-        s?.close();
-      },
-      reset() {
-        head = 0;
-        count = 0;
-        last.fill(0);
-        datagrams = 0;
-        malformed = 0;
-        dropped = 0;
-        repeated = 0;
-        warns.reset();
-        throttle.reset();
-        if (bridge) describe();
-      },
-      dispose() {
-        const s = socket;
-        socket = undefined;
-        s?.close();
-      },
-    };
+    const out = ctx.output(vectorShape(p.Channels));
+    const run = new HannesReceiverRun(ctx, udpBridge(ctx), out, {
+      host: p.Host,
+      port: p.Port,
+      channels: p.Channels,
+      maxDelay: p.MaxDelay,
+      paced,
+    });
+    return run.instance();
   },
 });
