@@ -1,30 +1,11 @@
 import { z } from "zod";
-import {
-  BlockConfigError,
-  defineBlock,
-  LegacyParamsError,
-  legacyPair,
-  vectorShape,
-} from "../../engine";
+import { defineBlock, LegacyParamsError, legacyPair } from "../../engine";
 import { vectorInput } from "../shared/inputs";
 import { extendedNumber } from "../shared/params";
 import { A, DOAS } from "./actuation";
 import { MAX_ITEMS } from "../shared/limits";
-
-/**
- * Strategies behind one interface (paper III-H): both turn one prediction vector into the next
- * actuation values, given the time since the previous prediction.
- */
-interface Strategy {
-  /** Writes the new target values of every DoF into `out` (before slew limiting and clipping). */
-  step(
-    pred: Float64Array,
-    offset: number,
-    dt: number,
-    current: Float64Array,
-    out: Float64Array,
-  ): void;
-}
+import { ControlRun } from "./control-algorithm-run";
+import { dofTable } from "./control-dofs";
 
 const dof = z.strictObject({
   Name: z.string().min(1).describe("Name of the degree of freedom (shown in the panel)"),
@@ -157,10 +138,6 @@ const params = z
 
 type Params = z.output<typeof params>;
 
-function clip01(x: number): number {
-  return x <= 0 ? 0 : x >= 1 ? 1 : x;
-}
-
 export const ControlAlgorithm = defineBlock({
   type: "ControlAlgorithm",
   category: "Control",
@@ -232,188 +209,14 @@ export const ControlAlgorithm = defineBlock({
   panel: "One bar per DoF with its current value and limits, the strategy, and the watchdog state.",
   create(ctx, p: Params) {
     const input = vectorInput(ctx, 0);
-    const width = input.shape.cols;
-    const dofs: DofSpec[] =
-      p.DoFs ??
-      Array.from({ length: width }, (_, k) => ({ Name: `dof${k}`, Positive: k, Rest: 0 }));
-    const atRest: string[] = [];
-    const oneSided: string[] = [];
-    dofs.forEach((d, i) => {
-      for (const [key, idx] of [
-        ["Positive", d.Positive],
-        ["Negative", d.Negative],
-      ] as const) {
-        if (idx !== undefined && idx >= width) {
-          if (p.MissingPredictions === "rest") {
-            if (key === "Positive") atRest.push(`${d.Name} (${idx})`);
-            else if (d.Positive < width) oneSided.push(`${d.Name} (${idx})`);
-            continue;
-          }
-          throw new BlockConfigError(
-            `DoFs[${i}] (${d.Name}): ${key} ${idx} is out of range for input '${input.info.source}' with ${width} predictions (valid: 0–${width - 1})`,
-            "DoFs",
-          );
-        }
-      }
-    });
-    if (atRest.length > 0 || oneSided.length > 0) {
-      ctx.warn(
-        `input '${input.info.source}' has ${width} predictions` +
-          (atRest.length > 0 ? `; at rest (no prediction): ${atRest.join(", ")}` : "") +
-          (oneSided.length > 0 ? `; driven one way only: ${oneSided.join(", ")}` : ""),
-      );
-    }
-    const m = dofs.length;
-    if (Array.isArray(p.Safe) && p.Safe.length !== m) {
-      throw new BlockConfigError(`Safe has ${p.Safe.length} values for ${m} DoFs`, "Safe");
-    }
-    // -1: no prediction (MissingPredictions: rest).
-    const pos = Int32Array.from(dofs, (d) => (d.Positive < width ? d.Positive : -1));
-    const neg = Int32Array.from(dofs, (d) =>
-      d.Negative !== undefined && d.Negative < width ? d.Negative : -1,
-    );
-    const rest = Float64Array.from(dofs, (d) => d.Rest);
-    const lo = Float64Array.from(dofs, (d) => d.Min ?? p.Min);
-    const hi = Float64Array.from(dofs, (d) => d.Max ?? p.Max);
-    dofs.forEach((d, i) => {
-      if (lo[i]! > hi[i]!)
-        throw new BlockConfigError(`DoFs[${i}] (${d.Name}): Min exceeds Max`, "DoFs");
-    });
-    const gain = new Float64Array(m);
-    const dead = new Float64Array(m);
-    let slew = p.SlewRate;
-    let strategyName = p.Strategy;
-    const applyParams = (): void => {
-      for (let i = 0; i < m; i++) {
-        gain[i] = dofs[i]!.Gain ?? p.Gain;
-        dead[i] = dofs[i]!.DeadZone ?? p.DeadZone;
-      }
-    };
-    applyParams();
-    const activation = (x: number, i: number): number => {
-      const a = clip01(x);
-      const d = dead[i]!;
-      return a <= d ? 0 : d >= 1 ? 0 : (a - d) / (1 - d);
-    };
-    const direct: Strategy = {
-      step(pred, off, _dt, _cur, out) {
-        for (let i = 0; i < m; i++) {
-          if (pos[i]! < 0) {
-            out[i] = rest[i]!;
-            continue;
-          }
-          const up = activation(pred[off + pos[i]!]!, i);
-          const down = neg[i]! >= 0 ? activation(pred[off + neg[i]!]!, i) : 0;
-          out[i] = rest[i]! + gain[i]! * (up - down);
-        }
-      },
-    };
-    const stepwise: Strategy = {
-      step(pred, off, dt, cur, out) {
-        for (let i = 0; i < m; i++) {
-          if (pos[i]! < 0) {
-            out[i] = rest[i]!;
-            continue;
-          }
-          const up = activation(pred[off + pos[i]!]!, i);
-          const down = neg[i]! >= 0 ? activation(pred[off + neg[i]!]!, i) : 0;
-          out[i] = cur[i]! + gain[i]! * (up - down) * dt;
-        }
-      },
-    };
-    let strategy = strategyName === "direct" ? direct : stepwise;
-    const current = Float64Array.from(rest, (r, i) => Math.min(hi[i]!, Math.max(lo[i]!, r)));
-    const target = new Float64Array(m);
-    let lastT = NaN;
-    let watchdogTripped = false;
-    const nominalDt = ctx.desiredRate > 0 ? 1 / ctx.desiredRate : 0.04;
-    const out = ctx.output(vectorShape(m));
-
-    /** Slew limit and clip `target` into `current` over dt seconds. */
-    const settle = (dt: number): void => {
-      const maxStep = slew === Infinity ? Infinity : slew * dt;
-      for (let i = 0; i < m; i++) {
-        let v = target[i]!;
-        if (v !== v) v = current[i]!; // a NaN prediction leaves the value where it is
-        const d = v - current[i]!;
-        if (d > maxStep) v = current[i]! + maxStep;
-        else if (d < -maxStep) v = current[i]! - maxStep;
-        current[i] = v < lo[i]! ? lo[i]! : v > hi[i]! ? hi[i]! : v;
-      }
-    };
-    const describe = (): void => {
-      ctx.setText(
-        watchdogTripped
-          ? `watchdog: no prediction for ${p.Timeout} s, sending ${Array.isArray(p.Safe) ? "the safe values" : p.Safe}`
-          : `${strategyName}, ${m} DoF${m === 1 ? "" : "s"}`,
-      );
-    };
-    describe();
-
-    // Watchdog: a one-shot re-armed by every prediction, so it costs nothing while predictions
-    // flow; once tripped it keeps sending the safe output at the desired rate (or 10 Hz).
-    const safeHz = ctx.desiredRate > 0 ? ctx.desiredRate : 10;
-    const trip = (t: number): void => {
-      if (!watchdogTripped) {
-        watchdogTripped = true;
-        ctx.warn(`no prediction for ${p.Timeout} s: sending the safe output`);
-        describe();
-      }
-      for (let i = 0; i < m; i++) {
-        target[i] = p.Safe === "rest" ? rest[i]! : p.Safe === "hold" ? current[i]! : p.Safe[i]!;
-      }
-      settle(1 / safeHz);
-      const f = out.frame(1);
-      f.t[0] = t;
-      for (let i = 0; i < m; i++) f.v[i] = current[i]!;
-      out.emit(f);
-      ctx.at(t + 1 / safeHz, trip);
-    };
-    let running = false;
-
-    return {
-      start() {
-        running = true;
-      },
-      stop() {
-        running = false;
-      },
-      process(f) {
-        const o = out.frame(f.n);
-        const s = f.stride;
-        for (let e = 0; e < f.n; e++) {
-          const t = f.t[e]!;
-          const dt = lastT === lastT && t > lastT ? t - lastT : nominalDt;
-          lastT = t;
-          strategy.step(f.v, e * s, dt, current, target);
-          settle(dt);
-          o.t[e] = t;
-          for (let i = 0; i < m; i++) o.v[e * m + i] = current[i]!;
-        }
-        if (watchdogTripped) {
-          watchdogTripped = false;
-          describe();
-        }
-        out.emit(o);
-        if (p.Timeout > 0 && running) ctx.at(ctx.now() + p.Timeout, trip);
-      },
-      reset() {
-        for (let i = 0; i < m; i++) current[i] = Math.min(hi[i]!, Math.max(lo[i]!, rest[i]!));
-        lastT = NaN;
-        watchdogTripped = false;
-        describe();
-      },
-      setParam(name, value) {
-        if (name === "Gain") p = { ...p, Gain: value as number };
-        else if (name === "DeadZone") p = { ...p, DeadZone: value as number };
-        else if (name === "SlewRate") slew = value as number;
-        else if (name === "Strategy") {
-          strategyName = value as Params["Strategy"];
-          strategy = strategyName === "direct" ? direct : stepwise;
-          describe();
-        }
-        applyParams();
-      },
-    };
+    const dofs = dofTable(ctx, p, input);
+    return new ControlRun(ctx, dofs, {
+      strategy: p.Strategy,
+      gain: p.Gain,
+      deadZone: p.DeadZone,
+      slewRate: p.SlewRate,
+      timeout: p.Timeout,
+      safe: p.Safe,
+    }).instance();
   },
 });
