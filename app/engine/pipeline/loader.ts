@@ -8,49 +8,32 @@
  *    and the `Pipeline:` settings;
  * 4. params (params.ts): zod, MOSAIC's positional form converted first (positional.ts);
  * 5. wiring (wiring.ts): inputs, ports and arity.
- * This file walks the top level and hands each block through the stages. Every stage is linear
+ * This file walks the top level and hands each block through the stages (load-block.ts). Every stage is linear
  * in the size of the file, and what a file may hold is bounded (LOAD_LIMITS in spec.ts: size,
  * blocks, values in Params, nesting): a refusal is one positioned error that names the limit.
  */
-import {
-  isAlias,
-  isMap,
-  isScalar,
-  isSeq,
-  Pair,
-  YAMLMap,
-  YAMLSeq,
-  type Alias,
-  type Node as YamlNode,
-} from "yaml";
+import { isMap, isScalar, type Document, type Node as YamlNode, type YAMLMap } from "yaml";
 import type { Catalog } from "../catalog";
 import { errorMessage } from "../diagnostics";
 import { Collector, describeNode, scalarString } from "./collector";
-import { isSettingsEntry, readBlockKeys, readSettings } from "./keys";
-import {
-  ignoredKeysWarning,
-  mappingMessage,
-  mosaicView,
-  resolvePendingRates,
-  type PendingRate,
-} from "./mosaic";
-import { convertedWarning, paramKeyPositions, paramsText, readParams } from "./params";
+import { isSettingsEntry, readSettings } from "./keys";
+import { loadBlock, type BlockOutcome, type LoadContext, type LoadState } from "./load-block";
+import { ignoredKeysWarning, resolvePendingRates } from "./mosaic";
 import { lineCounterOf, parseStage } from "./parse";
-import { LegacyParamsError } from "./legacy";
-import { decimalCommaWarning, positionalArgs } from "./positional";
 import {
   BLOCK_NAME_RE,
   LOAD_LIMITS,
-  type BlockSpec,
   type LoadLimits,
   type LoadResult,
   type PipelineSettings,
+  type SourcePos,
 } from "./spec";
 import { checkWiring } from "./wiring";
 import { checkPaths } from "./paths";
 
 export * from "./spec";
 export { objectKeys } from "./params";
+export { expandParams } from "./load-block";
 
 /**
  * Loads a pipeline file's text (`limits`: LOAD_LIMITS unless a caller raises or lowers them).
@@ -87,6 +70,7 @@ export function loadPipeline(
   }
 }
 
+/** The stages after the size check; `c` holds the diagnostics. */
 function loadParsed(
   c: Collector,
   source: string,
@@ -96,31 +80,74 @@ function loadParsed(
 ): LoadResult {
   const parsed = parseStage(c, source, limits);
   const doc = parsed.doc;
-  if (!doc || !parsed.ok) return { spec: undefined, diagnostics: c.list, ok: false, doc };
+  if (!doc || !parsed.ok) return failed(c, doc);
+  const root = topLevelMap(c, doc);
+  if (!root) return failed(c, doc);
+
+  const settings: PipelineSettings = { batchingMs: undefined };
+  const state: LoadState = {
+    blocks: [],
+    byName: new Map(),
+    ignoredKeys: [],
+    pendingRates: [],
+    values: 0,
+  };
+  readEntries(c, root, { catalog, limits, doc, aliases: parsed.aliases }, settings, state);
+  ignoredKeysWarning(c, state.ignoredKeys);
+  resolvePendingRates(c, state.pendingRates, state.byName);
+
+  // Stage 5: wiring.
+  checkWiring(c, state.blocks, state.byName, entryNames(root));
+  checkPaths(c, state.blocks, doc);
+
+  if (state.blocks.length === 0 && c.errors === 0) {
+    c.error("empty", { line: 1, col: 1 }, "the pipeline has no blocks");
+  }
+  const ok = c.errors === 0;
+  return {
+    spec: ok ? { file, blocks: state.blocks, byName: state.byName, settings } : undefined,
+    diagnostics: c.list,
+    ok,
+    doc,
+  };
+}
+
+function failed(c: Collector, doc: Document | undefined): LoadResult {
+  return { spec: undefined, diagnostics: c.list, ok: false, doc };
+}
+
+/** The document's top-level mapping; undefined (reported) when it is empty or not a mapping. */
+function topLevelMap(c: Collector, doc: Document): YAMLMap | undefined {
   const root = doc.contents;
   if (root === null || (isScalar(root) && (root.value === null || root.value === ""))) {
     c.error("empty", { line: 1, col: 1 }, "the pipeline is empty", {
       expected:
         "a mapping from block names to blocks, e.g. `Timer: { Type: ScheduledTimer, DesiredRate: 200 }`",
     });
-    return { spec: undefined, diagnostics: c.list, ok: false, doc };
+    return undefined;
   }
   if (!isMap(root)) {
     c.error("not-a-mapping", c.pos(root), `the top level is ${describeNode(root)}`, {
       expected: "a mapping from block names to blocks",
     });
-    return { spec: undefined, diagnostics: c.list, ok: false, doc };
+    return undefined;
   }
+  return root as YAMLMap;
+}
 
-  const blocks: BlockSpec[] = [];
-  const byName = new Map<string, BlockSpec>();
-  const settings: PipelineSettings = { batchingMs: undefined };
-  const ignoredKeys: { block: string; pair: Pair }[] = [];
-  const pendingRates: PendingRate[] = [];
+/**
+ * The top-level entries in order: the `Pipeline:` settings, and blocks (each through
+ * load-block.ts) up to the limit on their number.
+ */
+function readEntries(
+  c: Collector,
+  root: YAMLMap,
+  ctx: LoadContext,
+  settings: PipelineSettings,
+  state: LoadState,
+): void {
   let entries = 0;
-  let values = 0;
-
-  for (const pair of (root as YAMLMap).items) {
+  for (const pair of root.items) {
     const keyNode = pair.key as YamlNode | null;
     const at = c.pos(keyNode);
     const name = scalarString(keyNode);
@@ -128,240 +155,65 @@ function loadParsed(
       readSettings(c, pair.value as YAMLMap, settings);
       continue;
     }
-    if (++entries > limits.maxBlocks) {
-      c.error(
-        "too-many-blocks",
-        at,
-        `the pipeline has more than ${limits.maxBlocks} blocks; this is block ${entries}`,
-        { expected: `at most ${limits.maxBlocks} blocks in one pipeline` },
-      );
+    if (++entries > ctx.limits.maxBlocks) {
+      tooManyBlocks(c, at, ctx.limits.maxBlocks, entries);
       break;
     }
-    if (name === undefined || name === "") {
-      c.error("bad-name", at, "a block name must be a plain word", {
-        expected: "a name like `LowPass`",
-      });
-      continue;
-    }
-    if (!BLOCK_NAME_RE.test(name)) {
-      c.error("bad-name", at, `block name '${name}' is not valid`, {
+    const value = blockEntryValue(c, name, at, keyNode, pair.value);
+    if (name === undefined || !value) continue;
+    const outcome: BlockOutcome = loadBlock(c, { name, at, value }, ctx, state);
+    if (outcome === "stop") break;
+  }
+}
+
+function tooManyBlocks(c: Collector, at: SourcePos, maxBlocks: number, entries: number): void {
+  c.error(
+    "too-many-blocks",
+    at,
+    `the pipeline has more than ${maxBlocks} blocks; this is block ${entries}`,
+    { expected: `at most ${maxBlocks} blocks in one pipeline` },
+  );
+}
+
+/** A block entry's mapping; undefined (reported) when its name or its value is not valid. */
+function blockEntryValue(
+  c: Collector,
+  name: string | undefined,
+  at: SourcePos,
+  keyNode: YamlNode | null,
+  value: unknown,
+): YAMLMap | undefined {
+  if (name === undefined || name === "") {
+    c.error("bad-name", at, "a block name must be a plain word", {
+      expected: "a name like `LowPass`",
+    });
+    return undefined;
+  }
+  if (!BLOCK_NAME_RE.test(name)) {
+    c.error("bad-name", at, `block name '${name}' is not valid`, {
+      block: name,
+      expected:
+        "letters, digits, '_' or '-', starting with a letter or '_' ('.' is reserved for ports)",
+    });
+    return undefined;
+  }
+  if (!isMap(value)) {
+    c.error(
+      "bad-block",
+      c.pos((value as YamlNode | null) ?? keyNode),
+      `block '${name}' is ${describeNode(value)}`,
+      {
         block: name,
         expected:
-          "letters, digits, '_' or '-', starting with a letter or '_' ('.' is reserved for ports)",
-      });
-      continue;
-    }
-    const value = pair.value;
-    if (!isMap(value)) {
-      c.error(
-        "bad-block",
-        c.pos((value as YamlNode | null) ?? keyNode),
-        `block '${name}' is ${describeNode(value)}`,
-        {
-          block: name,
-          expected:
-            "a mapping with at least `Type`, e.g. `{ Type: Filter, Inputs: [Emg], Params: {...} }`",
-        },
-      );
-      continue;
-    }
-    const errorsBefore = c.errors;
-
-    // Stage 2: what the original's keys and names mean here.
-    const view = mosaicView(value);
-    for (const p of view.ignored) ignoredKeys.push({ block: name, pair: p });
-
-    // Stage 3: the block's keys.
-    const keys = readBlockKeys(c, name, at, value, catalog, view);
-    const def = keys.def;
-    if (!def) continue;
-
-    // Params with their aliases expanded (copies), within the limits on values.
-    const expanded = expandParams(keys.paramsNode, parsed.aliases, limits.maxParamsValues);
-    if (!expanded) {
-      c.error(
-        "too-many-values",
-        keys.paramsPos,
-        `block '${name}': Params hold more than ${limits.maxParamsValues} values (list items, keys and values, aliases expanded)`,
-        {
-          block: name,
-          expected: "large tables in a data file (FilePlayer, a model file) instead of in Params",
-        },
-      );
-      continue;
-    }
-    values += expanded.values;
-    if (values > limits.maxValues) {
-      c.error(
-        "too-many-values",
-        keys.paramsPos,
-        `the Params of the pipeline's blocks hold more than ${limits.maxValues} values in all (aliases expanded); this block's reach past it`,
-        { block: name },
-      );
-      break;
-    }
-    keys.paramsNode = expanded.node;
-
-    // Stage 4: params, positional ones as the original's blocks read them.
-    const written = isSeq(keys.paramsNode) ? positionalArgs(keys.paramsNode) : undefined;
-    if (isSeq(keys.paramsNode)) decimalCommaWarning(c, name, keys.paramsNode);
-    const rule = keys.rule;
-    let args = written;
-    let ruleOk = true;
-    let divisor: number | undefined;
-    if (rule) {
-      try {
-        if (rule.rateDivisor) divisor = rule.rateDivisor(written);
-        // Named params (a mapping) are already in the new block's form.
-        if (rule.args && !isMap(keys.paramsNode)) args = rule.args(written);
-      } catch (e) {
-        ruleOk = false;
-        c.error(
-          "legacy-params",
-          keys.paramsPos,
-          `block '${name}' (${keys.written} → ${def.type}): cannot convert positional Params [${(written ?? []).join(", ")}]: ${errorMessage(e)}`,
-          {
-            block: name,
-            ...(e instanceof LegacyParamsError && e.param ? { param: e.param } : {}),
-          },
-        );
-      }
-    }
-    const params = ruleOk
-      ? readParams(c, {
-          block: name,
-          def,
-          doc,
-          node: keys.paramsNode,
-          pos: keys.paramsPos,
-          args,
-        })
-      : undefined;
-
-    // One warning per block: what an old name became, or what positional Params became.
-    const converted =
-      params?.converted !== undefined && !isEmptyObject(params.converted)
-        ? `Params ${paramsText(params.converted)}`
-        : undefined;
-    let mapping: { message: string } | undefined;
-    if (keys.renamed && keys.written !== undefined) {
-      mapping = c.warn(
-        "type-alias",
-        keys.typePos,
-        mappingMessage(name, keys.written, def, rule, converted),
-        { block: name },
-      );
-    } else if (params?.converted !== undefined) {
-      convertedWarning(c, name, def.type, keys.paramsPos, params.converted);
-    }
-
-    if (c.errors > errorsBefore || !params?.ok) continue;
-    const spec: BlockSpec = {
-      name,
-      type: def.type,
-      def,
-      params: params.params,
-      desiredRate: keys.desiredRate,
-      inputs: keys.inputs,
-      path: keys.path,
-      worker: keys.worker,
-      batchingMs: keys.batchingMs,
-      queue: keys.queue,
-      layout: keys.layout,
-      outputs: params.outputs,
-      legacy: params.converted !== undefined,
-      pos: at,
-      paramsPos: keys.paramsPos,
-      inputsPos: keys.inputsPos,
-      paramPos: paramKeyPositions(c, keys.paramsNode),
-    };
-    blocks.push(spec);
-    byName.set(name, spec);
-    if (divisor !== undefined && mapping) {
-      pendingRates.push({
-        spec,
-        divisor,
-        at: keys.paramsPos,
-        warning: mapping,
-        withParams: converted !== undefined,
-      });
-    }
+          "a mapping with at least `Type`, e.g. `{ Type: Filter, Inputs: [Emg], Params: {...} }`",
+      },
+    );
+    return undefined;
   }
-  ignoredKeysWarning(c, ignoredKeys);
-  resolvePendingRates(c, pendingRates, byName);
-
-  // Stage 5: wiring.
-  const allNames = (root as YAMLMap).items
-    .map((p) => scalarString(p.key))
-    .filter((s): s is string => !!s);
-  checkWiring(c, blocks, byName, allNames);
-  checkPaths(c, blocks, doc);
-
-  if (blocks.length === 0 && c.errors === 0) {
-    c.error("empty", { line: 1, col: 1 }, "the pipeline has no blocks");
-  }
-  const ok = c.errors === 0;
-  return {
-    spec: ok ? { file, blocks, byName, settings } : undefined,
-    diagnostics: c.list,
-    ok,
-    doc,
-  };
+  return value;
 }
 
-function isEmptyObject(v: unknown): boolean {
-  return typeof v === "object" && v !== null && !Array.isArray(v) && Object.keys(v).length === 0;
-}
-
-/**
- * A block's Params node with its aliases expanded into copies (the document itself is not
- * changed: editors keep the file as written), and the values it holds; undefined when it holds
- * more than `max`. Without aliases the node is returned as it is. Copies keep the ranges of what
- * they copy, so errors point at the text an alias stands for.
- */
-export function expandParams(
-  node: unknown,
-  aliases: ReadonlyMap<Alias, YamlNode>,
-  max: number,
-): { node: unknown; values: number } | undefined {
-  let values = 0;
-  let hasAlias = false;
-  const stack: unknown[] = [node];
-  while (stack.length > 0) {
-    const n = stack.pop();
-    if (n === null || n === undefined) continue;
-    if (isAlias(n)) {
-      hasAlias = true;
-      const target = aliases.get(n);
-      if (target) {
-        stack.push(target);
-        continue;
-      }
-    }
-    if (++values > max) return undefined;
-    if (isMap(n)) for (const p of n.items) stack.push(p.key, p.value);
-    else if (isSeq(n)) for (const it of n.items) stack.push(it);
-  }
-  if (!hasAlias) return { node, values };
-  // Recursion is bounded: the parse stage refused aliases that nest deeper than maxDepth.
-  const copy = (n: unknown): unknown => {
-    if (isAlias(n)) {
-      const target = aliases.get(n);
-      return target ? copy(target) : n;
-    }
-    if (isMap(n)) {
-      const m = new YAMLMap();
-      Object.assign(m, { range: n.range, flow: n.flow, tag: n.tag });
-      m.items = n.items.map((p) => new Pair(copy(p.key), copy(p.value)));
-      return m;
-    }
-    if (isSeq(n)) {
-      const s = new YAMLSeq();
-      Object.assign(s, { range: n.range, flow: n.flow, tag: n.tag });
-      s.items = n.items.map(copy);
-      return s;
-    }
-    return n;
-  };
-  return { node: copy(node), values };
+/** Every top-level name, settings and refused blocks included (wiring's suggestions). */
+function entryNames(root: YAMLMap): string[] {
+  return root.items.map((p) => scalarString(p.key)).filter((s): s is string => !!s);
 }
