@@ -51,139 +51,184 @@ const isBlank = (c: string | undefined) => c === " " || c === "\t";
 
 /** The source with the layout of its multi-line flow collections made acceptable to `yaml`. */
 export function relaxFlowLayout(src: string): RelaxedText {
-  const out = src.split("");
-  const fixes: LayoutFix[] = [];
-  const n = src.length;
+  return new FlowLayoutScanner(src).run();
+}
 
-  let depth = 0; // flow nesting depth
-  let required = 0; // indentation a line of the current flow collection needs (opening line's + 1)
-  let quote: "'" | '"' | undefined; // inside a quoted scalar
-  let blockScalarIndent = -1; // >= 0: skipping the lines of a block scalar more indented than this
-  let lastSig = ""; // in flow context: the last significant character seen
-  let prevComment = -1; // offset of a comment ('#') on the previous line, or -1
+/**
+ * relaxFlowLayout's one pass over the lines: it follows quoted scalars, block scalars and flow
+ * nesting, and in a flow collection turns tabs in the indentation into spaces and joins a closing
+ * bracket indented less than the collection's lines need to the line above.
+ */
+class FlowLayoutScanner {
+  private readonly out: string[];
+  private readonly fixes: LayoutFix[] = [];
+  private depth = 0; // flow nesting depth
+  private required = 0; // indentation a line of the current flow collection needs (opening line's + 1)
+  private quote: "'" | '"' | undefined; // inside a quoted scalar
+  private blockScalarIndent = -1; // >= 0: skipping the lines of a block scalar more indented than this
+  private lastSig = ""; // in flow context: the last significant character seen
+  private prevComment = -1; // offset of a comment ('#') on the previous line, or -1
+  // The current line:
+  private lineIndent = 0;
+  private comment = -1; // offset of its comment, or -1
+  private nodeStart = true; // block context: may the next character start a node?
 
-  let ls = 0; // start of the current line
-  while (ls <= n) {
-    const nl = src.indexOf("\n", ls);
-    const le = nl < 0 ? n : nl; // end of the line (before its '\n')
-    const end = le > ls && src[le - 1] === "\r" ? le - 1 : le; // before a '\r\n'
-    let comment = -1;
-    let j = ls;
+  constructor(private readonly src: string) {
+    this.out = src.split("");
+  }
+
+  run(): RelaxedText {
+    const { src } = this;
+    const n = src.length;
+    let ls = 0; // start of the current line
+    while (ls <= n) {
+      const nl = src.indexOf("\n", ls);
+      const le = nl < 0 ? n : nl; // end of the line (before its '\n')
+      const end = le > ls && src[le - 1] === "\r" ? le - 1 : le; // before a '\r\n'
+      this.line(ls, end);
+      if (nl < 0) break;
+      ls = le + 1;
+    }
+    return { text: this.fixes.length > 0 ? this.out.join("") : src, fixes: this.fixes };
+  }
+
+  /** The line from `ls` to `end` (its line break excluded). */
+  private line(ls: number, end: number): void {
+    const { src } = this;
     // Leading whitespace.
     let k = ls;
     while (k < end && isBlank(src[k])) k++;
 
-    if (quote === undefined && blockScalarIndent >= 0) {
+    if (this.quote === undefined && this.blockScalarIndent >= 0) {
       const spaces = countSpaces(src, ls, end);
-      if (k === end || spaces > blockScalarIndent) {
-        ls = le + 1;
-        prevComment = -1;
-        continue;
+      if (k === end || spaces > this.blockScalarIndent) {
+        this.prevComment = -1;
+        return;
       }
-      blockScalarIndent = -1;
+      this.blockScalarIndent = -1;
     }
 
-    let lineIndent = 0;
-    if (quote === undefined) {
-      if (depth > 0 && k < end) {
-        // A tab in the indentation of a line inside a flow collection: a space.
-        let first = -1;
-        for (let t = ls; t < k; t++) {
-          if (src[t] === "\t") {
-            out[t] = " ";
-            if (first < 0) first = t;
-          }
-        }
-        if (first >= 0) fixes.push({ kind: "tab", offset: first });
-        const indent = k - ls;
-        const c = src[k];
-        const tolerated = depth === 1 && indent === required - 1;
-        if ((c === "]" || c === "}") && indent < required && !tolerated && ls > 0) {
-          // Join the closing bracket's line to the line above.
-          const br = ls >= 2 && src[ls - 2] === "\r" ? ls - 2 : ls - 1;
-          for (let t = br; t < ls; t++) out[t] = " ";
-          if (prevComment >= 0) for (let t = prevComment; t < br; t++) out[t] = " ";
-          fixes.push({ kind: "join", offset: br });
-        }
-      }
-      lineIndent = countSpaces(src, ls, end);
+    let j = ls;
+    this.lineIndent = 0;
+    if (this.quote === undefined) {
+      if (this.depth > 0 && k < end) this.fixFlowIndent(ls, k);
+      this.lineIndent = countSpaces(src, ls, end);
       j = k;
     }
+    this.prevComment = this.scan(ls, j, end);
+  }
 
-    // Block context: may the next character start a node (a flow collection, a quoted scalar)?
-    let nodeStart = true;
+  /**
+   * A line inside a flow collection, indented up to `k`: tabs in the indentation become spaces;
+   * a closing bracket indented less than required joins the line above.
+   */
+  private fixFlowIndent(ls: number, k: number): void {
+    const { src, out } = this;
+    let first = -1;
+    for (let t = ls; t < k; t++) {
+      if (src[t] === "\t") {
+        out[t] = " ";
+        if (first < 0) first = t;
+      }
+    }
+    if (first >= 0) this.fixes.push({ kind: "tab", offset: first });
+    const indent = k - ls;
+    const c = src[k];
+    const tolerated = this.depth === 1 && indent === this.required - 1;
+    if ((c === "]" || c === "}") && indent < this.required && !tolerated && ls > 0) {
+      // Join the closing bracket's line to the line above.
+      const br = ls >= 2 && src[ls - 2] === "\r" ? ls - 2 : ls - 1;
+      for (let t = br; t < ls; t++) out[t] = " ";
+      if (this.prevComment >= 0) for (let t = this.prevComment; t < br; t++) out[t] = " ";
+      this.fixes.push({ kind: "join", offset: br });
+    }
+  }
+
+  /** The line's characters from `from` to `end`; returns where its comment starts, or -1. */
+  private scan(ls: number, from: number, end: number): number {
+    const { src } = this;
+    this.comment = -1;
+    this.nodeStart = true;
+    let j = from;
     while (j < end) {
       const c = src[j]!;
-      if (quote !== undefined) {
-        if (quote === '"' && c === "\\") {
-          j += 2;
-          continue;
-        }
-        if (c === quote) {
-          if (quote === "'" && src[j + 1] === "'") {
-            j += 2;
-            continue;
-          }
-          quote = undefined;
-          lastSig = c;
-          nodeStart = false;
-        }
-        j++;
-        continue;
-      }
-      if (c === "#" && (j === ls || isBlank(src[j - 1]))) {
-        comment = j;
+      if (this.quote !== undefined) {
+        j = this.quoted(j);
+      } else if (c === "#" && (j === ls || isBlank(src[j - 1]))) {
+        this.comment = j;
         break;
-      }
-      if (isBlank(c)) {
+      } else if (isBlank(c)) {
         j++;
-        continue;
-      }
-      if (depth > 0) {
-        if (c === "[" || c === "{") depth++;
-        else if (c === "]" || c === "}") depth--;
-        else if ((c === "'" || c === '"') && (lastSig === "" || "[{,:?".includes(lastSig)))
-          quote = c;
-        lastSig = c;
-        if (depth === 0) nodeStart = false;
+      } else if (this.depth > 0) {
+        this.flowChar(c);
         j++;
-        continue;
+      } else {
+        j = this.blockChar(j, end);
       }
-      // Block context.
-      const next = src[j + 1];
-      const indicator = j + 1 >= end || isBlank(next);
-      if (nodeStart) {
-        if (c === "[" || c === "{") {
-          depth = 1;
-          required = lineIndent + 1;
-          lastSig = c;
-          nodeStart = false;
-        } else if (c === "'" || c === '"') {
-          quote = c;
-          nodeStart = false;
-        } else if (c === "|" || c === ">") {
-          blockScalarIndent = lineIndent;
-          // The rest of the line is the header (and maybe a comment).
-          const h = src.indexOf(" #", j);
-          if (h >= 0 && h < end) comment = h + 1;
-          break;
-        } else if ((c === "-" || c === "?" || c === ":") && indicator) {
-          // An indicator: a node may follow.
-        } else if (c === "&" || c === "!") {
-          while (j + 1 < end && !isBlank(src[j + 1])) j++;
-        } else {
-          nodeStart = false;
-        }
-      } else if (c === ":" && indicator) {
-        nodeStart = true;
-      }
-      j++;
     }
-    prevComment = comment;
-    if (nl < 0) break;
-    ls = le + 1;
+    return this.comment;
   }
-  return { text: fixes.length > 0 ? out.join("") : src, fixes };
+
+  /** Inside a quoted scalar: the character at `j`; returns the next offset to read. */
+  private quoted(j: number): number {
+    const { src } = this;
+    const c = src[j]!;
+    if (this.quote === '"' && c === "\\") return j + 2;
+    if (c === this.quote) {
+      if (this.quote === "'" && src[j + 1] === "'") return j + 2;
+      this.quote = undefined;
+      this.lastSig = c;
+      this.nodeStart = false;
+    }
+    return j + 1;
+  }
+
+  /** In flow context: a significant character `c` (nesting, the start of a quoted scalar). */
+  private flowChar(c: string): void {
+    if (c === "[" || c === "{") this.depth++;
+    else if (c === "]" || c === "}") this.depth--;
+    else if ((c === "'" || c === '"') && (this.lastSig === "" || "[{,:?".includes(this.lastSig)))
+      this.quote = c;
+    this.lastSig = c;
+    if (this.depth === 0) this.nodeStart = false;
+  }
+
+  /**
+   * In block context: the significant character at `j`, which may start a flow collection, a
+   * quoted scalar or a block scalar (the rest of the line is then its header); returns the next
+   * offset to read.
+   */
+  private blockChar(j: number, end: number): number {
+    const { src } = this;
+    const c = src[j]!;
+    const indicator = j + 1 >= end || isBlank(src[j + 1]);
+    if (!this.nodeStart) {
+      if (c === ":" && indicator) this.nodeStart = true;
+      return j + 1;
+    }
+    if (c === "[" || c === "{") {
+      this.depth = 1;
+      this.required = this.lineIndent + 1;
+      this.lastSig = c;
+      this.nodeStart = false;
+    } else if (c === "'" || c === '"') {
+      this.quote = c;
+      this.nodeStart = false;
+    } else if (c === "|" || c === ">") {
+      this.blockScalarIndent = this.lineIndent;
+      // The rest of the line is the header (and maybe a comment).
+      const h = src.indexOf(" #", j);
+      if (h >= 0 && h < end) this.comment = h + 1;
+      return end;
+    } else if ((c === "-" || c === "?" || c === ":") && indicator) {
+      // An indicator: a node may follow.
+    } else if (c === "&" || c === "!") {
+      while (j + 1 < end && !isBlank(src[j + 1])) j++;
+    } else {
+      this.nodeStart = false;
+    }
+    return j + 1;
+  }
 }
 
 function countSpaces(src: string, from: number, end: number): number {
