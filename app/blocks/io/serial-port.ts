@@ -1,13 +1,5 @@
 import { z } from "zod";
-import {
-  BlockConfigError,
-  defineBlock,
-  shapeSize,
-  vectorShape,
-  type Frame,
-  type SerialHandle,
-  type SerialStatus,
-} from "../../engine";
+import { BlockConfigError, defineBlock, shapeSize, vectorShape } from "../../engine";
 import {
   CHECKSUMS,
   FIELD_TYPES,
@@ -19,6 +11,7 @@ import {
   type Decoder,
   type Encoder,
 } from "./serial-framing";
+import { SerialPortRun } from "./serial-port-run";
 
 const params = z.strictObject({
   Path: z
@@ -148,120 +141,9 @@ export const SerialPort = defineBlock({
       );
     }
     const out = ctx.output(vectorShape(channels));
-    let handle: SerialHandle | undefined;
-    let state: SerialStatus | "unavailable" = "closed";
-    let message = "";
-    let written = 0;
-    let writeErrors = 0;
-    let lastText = "";
-
-    const refresh = (): void => {
-      const s = decoder.stats;
-      let text: string;
-      switch (state) {
-        case "unavailable":
-          text =
-            "serial ports are not available here (browser build): run the pipeline with mosaic run or the desktop app";
-          break;
-        case "open":
-          text = `${p.Path} open @ ${p.BaudRate} Bd · ${s.frames} frames`;
-          break;
-        case "opening":
-          text = `opening ${p.Path}…`;
-          break;
-        case "closed":
-          text = `${p.Path} closed`;
-          break;
-        case "error":
-          text = `${p.Path}: ${message}`;
-          break;
-      }
-      if (written > 0) text += ` · ${written} written`;
-      if (s.malformed > 0) text += ` · ${s.malformed} malformed (last: ${s.lastProblem})`;
-      if (s.skipped > 0) text += ` · ${s.skipped} bytes skipped`;
-      if (writeErrors > 0) text += ` · ${writeErrors} writes failed`;
-      if (text !== lastText) {
-        lastText = text;
-        ctx.setText(text);
-      }
-    };
-
-    const onData = (bytes: Uint8Array): void => {
-      const before = decoder.stats.malformed;
-      decoder.push(bytes, (values) => {
-        const f = out.frame(1);
-        f.t[0] = ctx.now();
-        f.v.set(values);
-        out.emit(f);
-      });
-      if (decoder.stats.malformed !== before) ctx.warn(`${p.Path}: ${decoder.stats.lastProblem}`);
-      refresh();
-    };
-
-    const onStatus = (s: SerialStatus, msg?: string): void => {
-      const was = state;
-      state = s;
-      message = msg ?? "";
-      if (s === "error" && was !== "error") ctx.warn(`${p.Path}: ${message}`);
-      if (s !== "open") decoder.reset();
-      refresh();
-    };
-
-    return {
-      start() {
-        const bridge = ctx.io.serial;
-        if (!bridge) {
-          state = "unavailable";
-          refresh();
-          return;
-        }
-        handle = bridge.open({
-          path: p.Path,
-          baudRate: p.BaudRate,
-          dataBits: p.DataBits,
-          stopBits: p.StopBits,
-          parity: p.Parity,
-          reconnectMs: p.Reconnect * 1000,
-          onData,
-          onStatus,
-        });
-      },
-      stop() {
-        handle?.close();
-        handle = undefined;
-        if (state !== "unavailable") state = "closed";
-        refresh();
-      },
-      process(frame: Frame) {
-        if (!handle || state !== "open") {
-          writeErrors += frame.n;
-          refresh();
-          return;
-        }
-        const width = frame.stride;
-        for (let e = 0; e < frame.n; e++) {
-          handle.write(encoder.encode(frame.v.subarray(e * width, (e + 1) * width)));
-          written++;
-        }
-        refresh();
-      },
-      reset() {
-        decoder.reset();
-      },
-      dispose() {
-        handle?.close();
-        handle = undefined;
-      },
-      actions: {
-        info: {
-          label: "Port info",
-          description: "Shows the port settings and counters",
-          run: () =>
-            `${p.Path} ${p.BaudRate} Bd ${p.DataBits}${p.Parity[0]!.toUpperCase()}${p.StopBits}, ` +
-            `${p.Framing}${p.Framing === "binary" ? ` (${structSize({ fields: p.Fields, sync: p.Sync, checksum: p.Checksum, littleEndian: true })} bytes/frame)` : ""}: ` +
-            `${decoder.stats.frames} frames, ${decoder.stats.malformed} malformed, ${written} written`,
-        },
-      },
-    };
+    const info = (): string =>
+      `${p.Path} ${p.BaudRate} Bd ${p.DataBits}${p.Parity[0]!.toUpperCase()}${p.StopBits}, ` +
+      `${p.Framing}${p.Framing === "binary" ? ` (${structSize({ fields: p.Fields, sync: p.Sync, checksum: p.Checksum, littleEndian: true })} bytes/frame)` : ""}`;
+    return new SerialPortRun(ctx, p, decoder, encoder, out, info).instance();
   },
 });
