@@ -204,6 +204,147 @@ pub(crate) fn sym_update(a: &mut [f64], beta: f64, c: f64, u: &[f64], p: usize) 
     }
 }
 
+/// The most updates [`sym_update_queued`] takes at once.
+pub(crate) const SYM_QUEUE: usize = 8;
+
+/// Values of a queue of `δ` vectors for `p` inputs (see [`queue_at`]).
+pub(crate) fn queue_size(p: usize) -> usize {
+    p.div_ceil(2) * 2 * SYM_QUEUE
+}
+
+/// Where `δ_q[j]` of queued update `q` is kept: by pairs of columns, each
+/// pair's updates side by side (`δ_0[j], δ_0[j+1], δ_1[j], δ_1[j+1], …` for
+/// an even `j`), so that one pass over S reads them in order.
+#[inline(always)]
+pub(crate) fn queue_at(q: usize, j: usize) -> usize {
+    (j / 2) * 2 * SYM_QUEUE + 2 * q + j % 2
+}
+
+/// `n = coef.len()` calls of [`sym_update`] in one pass over `a`: update `q`
+/// is `A ← β_q A + c_q·δ_qδ_qᵀ`, with `(β_q, c_q) = coef[q]` and `δ_q` in
+/// `deltas` ([`queue_at`]). Each element gets the updates in queue order
+/// by the same operations (bit-identical), but is loaded and stored once.
+///
+/// [`sym_update`] skips a row when β = 1 and `c·δ_i = 0`; here such an
+/// update adds `±0`, which leaves every value but `−0` as it is. S holds no
+/// `−0` unless one was loaded (from +0, sums and products by β > 0 give +0),
+/// so `neg_zero` (S may hold one) selects the exact per-element path.
+pub(crate) fn sym_update_queued(
+    a: &mut [f64],
+    coef: &[(f64, f64)],
+    deltas: &[f64],
+    p: usize,
+    neg_zero: bool,
+) {
+    let n = coef.len();
+    let plain = coef.iter().all(|&(beta, _)| beta == 1.0);
+    let (mut b, mut cu) = ([1.0; SYM_QUEUE], [0.0; SYM_QUEUE]);
+    for (q, &(beta, _)) in coef.iter().enumerate() {
+        b[q] = beta;
+    }
+    if neg_zero {
+        for i in 0..p {
+            for (j, v) in (i..p).zip(a[i * p + i..(i + 1) * p].iter_mut()) {
+                *v = queued_element(*v, coef, deltas, i, j);
+            }
+        }
+        return;
+    }
+    // By blocks of columns, so that the block's δ (16 KiB) stay in L1 over the rows.
+    const BLOCK: usize = 256;
+    for j0 in (0..p).step_by(BLOCK) {
+        let j1 = (j0 + BLOCK).min(p);
+        for i in 0..j1 {
+            for (q, &(_, c)) in coef.iter().enumerate() {
+                cu[q] = c * deltas[queue_at(q, i)];
+            }
+            let mut j = i.max(j0);
+            let row = &mut a[i * p + j..i * p + j1];
+            // An odd first column alone: the rest starts at a pair.
+            let row = if j % 2 == 1 {
+                let mut v = row[0];
+                for q in 0..n {
+                    let d = deltas[queue_at(q, j)];
+                    v = if plain {
+                        v + cu[q] * d
+                    } else {
+                        b[q] * v + cu[q] * d
+                    };
+                }
+                row[0] = v;
+                j += 1;
+                &mut row[1..]
+            } else {
+                row
+            };
+            let dt = &deltas[queue_at(0, j)..];
+            macro_rules! by_count {
+                ($($k:literal)*) => {
+                    match (n, plain) {
+                        $(($k, true) => queued_rows::<$k, true>(row, dt, &b, &cu),
+                          ($k, false) => queued_rows::<$k, false>(row, dt, &b, &cu),)*
+                        _ => {}
+                    }
+                };
+            }
+            by_count!(1 2 3 4 5 6 7 8);
+        }
+    }
+}
+
+/// The `N` queued updates of [`sym_update_queued`] on the part of a row
+/// that starts at an even column (`dt`: that column's pair onwards):
+/// `v ← v + cu_q·δ_q` (`PLAIN`, all β = 1) or `v ← β_q·v + cu_q·δ_q`.
+#[inline(always)]
+fn queued_rows<const N: usize, const PLAIN: bool>(
+    row: &mut [f64],
+    dt: &[f64],
+    b: &[f64; SYM_QUEUE],
+    cu: &[f64; SYM_QUEUE],
+) {
+    let done = simd::queued_rows::<N, PLAIN>(row, dt, b, cu);
+    for (rc, dc) in row[done..]
+        .chunks_mut(2)
+        .zip(dt[done * SYM_QUEUE..].chunks_exact(2 * SYM_QUEUE))
+    {
+        for (l, v) in rc.iter_mut().enumerate() {
+            let mut x = *v;
+            for q in 0..N {
+                let d = dc[2 * q + l];
+                x = if PLAIN {
+                    x + cu[q] * d
+                } else {
+                    b[q] * x + cu[q] * d
+                };
+            }
+            *v = x;
+        }
+    }
+}
+
+/// Element `(i, j)`, `i ≤ j`, of `a` after the queued updates of
+/// [`sym_update_queued`], by [`sym_update`]'s operations (with its skips).
+pub(crate) fn queued_element(
+    mut v: f64,
+    coef: &[(f64, f64)],
+    deltas: &[f64],
+    i: usize,
+    j: usize,
+) -> f64 {
+    for (q, &(beta, c)) in coef.iter().enumerate() {
+        let cu = c * deltas[queue_at(q, i)];
+        let d = deltas[queue_at(q, j)];
+        if beta == 1.0 {
+            if cu != 0.0 {
+                v += cu * d;
+            }
+        } else {
+            v = beta * v + cu * d;
+        }
+    }
+    v
+}
+
 /// `y ← y + a·x` (`x` at least as long as `y`).
 #[inline]
 fn add_scaled(y: &mut [f64], a: f64, x: &[f64]) {
@@ -392,6 +533,37 @@ mod simd {
         y.len() - y.len() % 2
     }
 
+    /// [`super::queued_rows`] on the pairs of `row`.
+    #[inline(always)]
+    pub(super) fn queued_rows<const N: usize, const PLAIN: bool>(
+        row: &mut [f64],
+        dt: &[f64],
+        b: &[f64; super::SYM_QUEUE],
+        cu: &[f64; super::SYM_QUEUE],
+    ) -> usize {
+        if !mosaic_dsp::simd_enabled() {
+            return 0;
+        }
+        let bv: [v128; N] = core::array::from_fn(|q| f64x2_splat(b[q]));
+        let cv: [v128; N] = core::array::from_fn(|q| f64x2_splat(cu[q]));
+        for (rc, dc) in row
+            .chunks_exact_mut(2)
+            .zip(dt.chunks_exact(2 * super::SYM_QUEUE))
+        {
+            let mut v = ld(rc);
+            for q in 0..N {
+                let d = f64x2_mul(cv[q], ld(&dc[2 * q..]));
+                v = if PLAIN {
+                    f64x2_add(v, d)
+                } else {
+                    f64x2_add(f64x2_mul(bv[q], v), d)
+                };
+            }
+            st(rc, v);
+        }
+        row.len() - row.len() % 2
+    }
+
     /// The four partial sums of [`super::dot`] over `x`, `y` (lengths a
     /// multiple of 4), combined; `None` when disabled.
     #[inline]
@@ -441,6 +613,16 @@ mod simd {
         _: &mut [f64],
         _: f64,
         _: f64,
+    ) -> usize {
+        0
+    }
+
+    #[inline(always)]
+    pub(super) fn queued_rows<const N: usize, const PLAIN: bool>(
+        _: &mut [f64],
+        _: &[f64],
+        _: &[f64; super::SYM_QUEUE],
+        _: &[f64; super::SYM_QUEUE],
     ) -> usize {
         0
     }

@@ -196,8 +196,23 @@ pub struct Ridge {
     lambda_eff: f64,
     x_mean: Vec<f64>,
     y_mean: Vec<f64>,
-    /// Scatter S, p × p; the upper triangle is maintained.
+    /// Scatter S, p × p; the upper triangle is maintained, but for the
+    /// `queued` updates not yet applied (see [`Ridge::flush_s`]).
     s: Vec<f64>,
+    /// Updates of S not yet applied, oldest first: `(β, c)` of
+    /// `S ← βS + c·δδᵀ`, with δ in `queue_delta`. Nothing but
+    /// `refactor` and `save` reads S, and the factor R is updated directly,
+    /// so S's update is deferred and done for up to `queue_len` samples in
+    /// one pass (S is p² values: at p = 1024 one pass streams 8 MiB).
+    queued: Vec<(f64, f64)>,
+    /// The queued δ ([`linalg::queue_at`]).
+    queue_delta: Vec<f64>,
+    /// S may hold a −0 (only from a loaded state; see
+    /// [`linalg::sym_update_queued`]).
+    neg_zero: bool,
+    /// Most updates queued before they are applied (0: S is updated with
+    /// each sample, fused with R's update when β = 1).
+    queue_len: usize,
     /// Cross scatter C, p × M.
     c: Vec<f64>,
     /// Diagonal of the penalty: A = S + λ_eff·diag(penalty) (all 1 but with
@@ -243,6 +258,10 @@ impl Ridge {
             x_mean: vec![0.0; p],
             y_mean: vec![0.0; m],
             s: vec![0.0; p * p],
+            queued: Vec::with_capacity(linalg::SYM_QUEUE),
+            queue_delta: vec![0.0; linalg::queue_size(p)],
+            neg_zero: false,
+            queue_len: linalg::SYM_QUEUE,
             c: vec![0.0; p * m],
             penalty: vec![1.0; p],
             r: vec![0.0; p * p],
@@ -313,6 +332,7 @@ impl Ridge {
     /// Restores λ_eff = λ after forgetting, and removes the rounding that
     /// rank-one updates accumulate (O(p³ + p²M)).
     pub fn refactor(&mut self) {
+        self.flush_s();
         let p = self.p;
         let lambda = self.params.lambda;
         let scale = (0..p).map(|i| self.s[i * p + i]).fold(0.0, f64::max);
@@ -380,6 +400,41 @@ impl Ridge {
         self.rejected += 1;
     }
 
+    /// Applies the queued updates of S.
+    fn flush_s(&mut self) {
+        if !self.queued.is_empty() {
+            linalg::sym_update_queued(
+                &mut self.s,
+                &self.queued,
+                &self.queue_delta,
+                self.p,
+                self.neg_zero,
+            );
+            self.queued.clear();
+        }
+    }
+
+    /// Element (i, j) of S, `i ≤ j`, with the queued updates.
+    fn s_at(&self, i: usize, j: usize) -> f64 {
+        let v = self.s[i * self.p + j];
+        linalg::queued_element(v, &self.queued, &self.queue_delta, i, j)
+    }
+
+    /// Queues `S ← βS + c·δδᵀ` (δ: `self.delta`), applying the queue when full.
+    fn queue_s(&mut self, beta: f64, c: f64) {
+        if beta == 1.0 && c == 0.0 {
+            return; // nothing to add (what sym_update does: every c·δ_i is 0)
+        }
+        let q = self.queued.len();
+        for (j, &d) in self.delta.iter().enumerate() {
+            self.queue_delta[linalg::queue_at(q, j)] = d;
+        }
+        self.queued.push((beta, c));
+        if self.queued.len() >= self.queue_len {
+            self.flush_s();
+        }
+    }
+
     /// True when the factor's diagonal spans more than 9 orders of magnitude:
     /// cond(A) ≥ (max rᵢᵢ / min rᵢᵢ)² > 1e18, beyond double precision, where
     /// rank-one updates lose the smallest directions.
@@ -439,9 +494,13 @@ impl Ridge {
         self.weight_sum = new;
         self.samples += 1;
         // Normal equations: S ← βS + c·δδᵀ, C ← βC + c·δ·δyᵀ, λ_eff ← βλ_eff.
-        // Without forgetting, S's update is done below with R's, in one pass over both.
-        let fused = beta == 1.0 && c > 0.0;
-        if !fused {
+        // S's update is queued; unqueued and without forgetting, it is done below with R's, in
+        // one pass over both.
+        let queue = self.queue_len > 0;
+        let fused = !queue && beta == 1.0 && c > 0.0;
+        if queue {
+            self.queue_s(beta, c);
+        } else if !fused {
             linalg::sym_update(&mut self.s, beta, c, &self.delta, p);
         }
         for i in 0..p {
@@ -651,9 +710,9 @@ impl Ridge {
         for i in 0..p {
             for j in 0..p {
                 let v = if j >= i {
-                    self.s[i * p + j]
+                    self.s_at(i, j)
                 } else {
-                    self.s[j * p + i]
+                    self.s_at(j, i)
                 };
                 w.put(&[v]);
             }
@@ -756,6 +815,8 @@ impl Ridge {
         self.x_mean.copy_from_slice(x_mean);
         self.y_mean.copy_from_slice(y_mean);
         self.s.copy_from_slice(s);
+        self.queued.clear();
+        self.neg_zero = s.iter().any(|v| v.to_bits() == (-0.0f64).to_bits());
         self.c.copy_from_slice(c);
         self.r = r;
         // The saved weights themselves (they agree with the normal equations, checked above):
@@ -869,6 +930,8 @@ impl PredictingMachine for Ridge {
         self.x_mean.fill(0.0);
         self.y_mean.fill(0.0);
         self.s.fill(0.0);
+        self.queued.clear();
+        self.neg_zero = false;
         self.c.fill(0.0);
         self.w.fill(0.0);
         self.r.fill(0.0);
@@ -910,4 +973,131 @@ pub(crate) fn check_pairs(xl: usize, p: usize, yl: usize, m: usize) -> Result<us
         });
     }
     Ok(n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bits(v: &[f64]) -> Vec<u64> {
+        v.iter().map(|x| x.to_bits()).collect()
+    }
+
+    /// Queued updates of S give, bit for bit, what updating S with every sample gives: S, the
+    /// weights, predictions, saved states (saved with updates still queued) and refactors.
+    #[test]
+    fn queued_scatter_updates_are_bit_identical() {
+        for &(p, m) in &[(13usize, 2usize), (133, 3)] {
+            for &beta in &[1.0, 0.97] {
+                for &intercept in &[true, false] {
+                    for &every in &[0usize, 7] {
+                        let params = RidgeParams {
+                            lambda: 0.5,
+                            forgetting: beta,
+                            intercept,
+                            refactor_every: every,
+                        };
+                        let mut a = Ridge::new(p, m, params).unwrap();
+                        let mut b = Ridge::new(p, m, params).unwrap();
+                        a.queue_len = 0;
+                        assert_eq!(b.queue_len, linalg::SYM_QUEUE);
+                        let n = if p > 100 { 80 } else { 400 };
+                        let mut seed = 0x9e37_79b9_7f4a_7c15u64 ^ p as u64;
+                        let mut rnd = || {
+                            seed ^= seed << 13;
+                            seed ^= seed >> 7;
+                            seed ^= seed << 17;
+                            (seed % 20001) as f64 / 10000.0 - 1.0
+                        };
+                        let (mut ya, mut yb) = (vec![0.0; m], vec![0.0; m]);
+                        let mut sa = vec![0.0; a.state_len()];
+                        let mut sb = vec![0.0; b.state_len()];
+                        for t in 0..n {
+                            // Zeros (δ_i = 0 without intercept), a repeated sample, large values.
+                            let x: Vec<f64> = (0..p)
+                                .map(|i| match (t + i) % 11 {
+                                    0 => 0.0,
+                                    1 => 30.0 * rnd(),
+                                    _ => rnd(),
+                                })
+                                .collect();
+                            let y: Vec<f64> =
+                                (0..m).map(|o| x[o] - 0.5 * x[p - 1 - o] + rnd()).collect();
+                            for _ in 0..1 + (t % 17 == 3) as usize {
+                                assert!(a.learn_one(&x, &y));
+                                assert!(b.learn_one(&x, &y));
+                            }
+                            a.predict_one(&x, &mut ya);
+                            b.predict_one(&x, &mut yb);
+                            assert_eq!(bits(&ya), bits(&yb), "p {p} beta {beta} t {t}");
+                            assert_eq!(bits(&a.w), bits(&b.w));
+                            if t % 29 == 5 {
+                                a.save_state(&mut sa).unwrap();
+                                b.save_state(&mut sb).unwrap();
+                                assert_eq!(bits(&sa), bits(&sb), "p {p} beta {beta} t {t}");
+                            }
+                        }
+                        assert_eq!(a.refactors, b.refactors);
+                        a.save_state(&mut sa).unwrap();
+                        b.save_state(&mut sb).unwrap();
+                        assert_eq!(bits(&sa), bits(&sb));
+                        b.refactor();
+                        a.refactor();
+                        assert!(b.queued.is_empty());
+                        assert_eq!(bits(&a.s), bits(&b.s));
+                        assert_eq!(bits(&a.r), bits(&b.r));
+                        assert_eq!(bits(&a.w), bits(&b.w));
+                        // A loaded state drops what was queued before.
+                        b.learn_one(&vec![1.0; p], &vec![1.0; m]);
+                        b.load_state(&sa).unwrap();
+                        a.load_state(&sa).unwrap();
+                        assert!(b.queued.is_empty());
+                        assert_eq!(bits(&a.s), bits(&b.s));
+                    }
+                }
+            }
+        }
+    }
+
+    /// A −0 in a loaded S stays −0 where the unqueued update skips its row (β = 1, δᵢ = 0).
+    #[test]
+    fn queued_updates_keep_a_loaded_negative_zero() {
+        let (p, m) = (6, 1);
+        let params = RidgeParams {
+            intercept: false,
+            ..RidgeParams::default()
+        };
+        let mut a = Ridge::new(p, m, params).unwrap();
+        let mut b = Ridge::new(p, m, params).unwrap();
+        a.queue_len = 0;
+        let x = |t: usize| -> Vec<f64> {
+            (0..p)
+                .map(|i| {
+                    if i == 2 {
+                        0.0
+                    } else {
+                        (t * 7 + i) as f64 % 5.0 - 2.0
+                    }
+                })
+                .collect()
+        };
+        for t in 0..5 {
+            a.learn_one(&x(t), &[t as f64]);
+        }
+        let mut st = vec![0.0; a.state_len()];
+        a.save_state(&mut st).unwrap();
+        let s0 = 3 + 2 * p + m; // the scatter section
+        assert_eq!(st[s0 + 2 * p + 2], 0.0);
+        st[s0 + 2 * p + 2] = -0.0;
+        a.load_state(&st).unwrap();
+        b.load_state(&st).unwrap();
+        assert!(b.neg_zero);
+        for t in 5..30 {
+            a.learn_one(&x(t), &[t as f64]);
+            b.learn_one(&x(t), &[t as f64]);
+        }
+        b.flush_s();
+        assert_eq!(bits(&a.s), bits(&b.s));
+        assert_eq!(a.s[2 * p + 2].to_bits(), (-0.0f64).to_bits());
+    }
 }
