@@ -5,10 +5,14 @@ import {
   errorMessage,
   formatShape,
   vectorShape,
+  type BlockContext,
+  type Frame,
+  type OutputPort,
+  type Shape,
 } from "../../engine";
 import { ARTIFACT_REASONS, ArtifactKernel } from "../../engine/dsp";
 import { requireDsp } from "../shared/dsp";
-import { inputName, signalInput } from "../shared/inputs";
+import { inputName, signalInput, type SignalInput } from "../shared/inputs";
 import { extendedNumber } from "../shared/params";
 import { TextThrottle } from "../shared/text";
 
@@ -74,6 +78,137 @@ const params = z
 
 const SHORT = ["clip", "flat", "jump", "drift", "nonfinite"] as const;
 
+type Params = z.output<typeof params>;
+
+/** The input, windows [L, C] with L ≥ 3. */
+function windowInput(ctx: BlockContext): SignalInput {
+  const sig = signalInput(ctx, 0);
+  if (sig.shape.rows < 3) {
+    throw new BlockConfigError(
+      `input ${inputName(sig.info)} has shape ${formatShape(sig.shape)}; ArtifactRejection ` +
+        "judges windows [L, C] with L ≥ 3: put a SlidingWindow before it",
+    );
+  }
+  return sig;
+}
+
+function createKernel(p: Params, rows: number, cols: number): ArtifactKernel {
+  try {
+    return new ArtifactKernel({
+      rows,
+      channels: cols,
+      ...(p.RailLow !== undefined ? { railLow: p.RailLow } : {}),
+      ...(p.RailHigh !== undefined ? { railHigh: p.RailHigh } : {}),
+      clipTolerance: p.ClipTolerance,
+      clipFraction: p.ClipFraction,
+      flatThreshold: p.FlatThreshold,
+      jumpFactor: p.JumpFactor,
+      ...(p.DriftThreshold !== undefined ? { driftThreshold: p.DriftThreshold } : {}),
+      hard: p.Mode === "hard",
+    });
+  } catch (e) {
+    throw new BlockConfigError(`cannot create the artifact rules: ${errorMessage(e)}`);
+  }
+}
+
+/** The status line: rejected channel-windows per reason, and the first 4 channels rejected. */
+function summaryText(kernel: ArtifactKernel, cols: number): string {
+  const total = [0, 0, 0, 0, 0, 0];
+  const bad: string[] = [];
+  for (let c = 0; c < cols; c++) {
+    for (let r = 0; r < 6; r++) total[r]! += kernel.counter(c, r);
+    if (kernel.counter(c, 5) > 0 && bad.length < 4) {
+      const why = SHORT.map((s, r) => [s, kernel.counter(c, r)] as const)
+        .filter(([, v]) => v > 0)
+        .map(([s, v]) => `${s} ${v}`)
+        .join(" ");
+      bad.push(`ch${c}: ${why}`);
+    }
+  }
+  const reasons = SHORT.map((s, r) => `${s} ${total[r]}`).join(", ");
+  const cells = kernel.windows() * cols;
+  return (
+    `rejected ${total[5]} of ${cells} channel-windows (${reasons})` +
+    (bad.length > 0 ? `; ${bad.join("; ")}${total[5]! > 0 && bad.length === 4 ? "; …" : ""}` : "")
+  );
+}
+
+/** The `counters` action's answer: one CSV line per channel. */
+function countersText(kernel: ArtifactKernel, cols: number): string {
+  const lines = [`windows ${kernel.windows()}`, `channel,${ARTIFACT_REASONS.join(",")},rejected`];
+  for (let c = 0; c < cols; c++) {
+    const row = [0, 1, 2, 3, 4, 5].map((r) => kernel.counter(c, r));
+    lines.push(`${c},${row.join(",")}`);
+  }
+  return lines.join("\n");
+}
+
+/** One ArtifactRejection at run time: the kernel, its outputs and the status line. */
+class ArtifactRun {
+  private readonly clean: OutputPort;
+  private readonly mask: OutputPort;
+  private readonly cols: number;
+  private readonly text = new TextThrottle(0.5);
+  private disposed = false;
+
+  constructor(
+    private readonly ctx: BlockContext,
+    private readonly kernel: ArtifactKernel,
+    shape: Shape,
+  ) {
+    this.cols = shape.cols;
+    this.clean = ctx.output(shape, "clean");
+    this.mask = ctx.output(vectorShape(shape.cols), "mask");
+    this.showSummary();
+  }
+
+  process(f: Frame): void {
+    const n = f.n;
+    if (n === 0) return;
+    const co = this.clean.frame(n);
+    const mo = this.mask.frame(n);
+    this.kernel.process(f.v, n, co.v, mo.v);
+    const ft = f.t;
+    for (let e = 0; e < n; e++) {
+      co.t[e] = ft[e]!;
+      mo.t[e] = ft[e]!;
+    }
+    this.clean.emit(co);
+    this.mask.emit(mo);
+    // The status line is rebuilt at most every 0.5 s of pipeline time, and when it stops.
+    if (this.text.due(ft[n - 1]!)) this.showSummary();
+  }
+
+  stop(): void {
+    if (!this.disposed) this.showSummary();
+  }
+
+  reset(): void {
+    this.kernel.reset();
+    this.text.reset();
+    this.showSummary();
+  }
+
+  resetCounters(): string {
+    this.kernel.resetCounters();
+    this.showSummary();
+    return "counters reset";
+  }
+
+  counters(): string {
+    return countersText(this.kernel, this.cols);
+  }
+
+  dispose(): void {
+    this.disposed = true;
+    this.kernel.dispose();
+  }
+
+  private showSummary(): void {
+    this.ctx.setText(summaryText(this.kernel, this.cols));
+  }
+}
+
 export const ArtifactRejection = defineBlock({
   type: "ArtifactRejection",
   category: "Flow control",
@@ -103,115 +238,33 @@ export const ArtifactRejection = defineBlock({
     "Mask of the latest window per channel and the cumulative counters per reason and channel.",
   create(ctx, p) {
     requireDsp(ctx.type);
-    const sig = signalInput(ctx, 0);
-    const { rows, cols } = sig.shape;
-    if (rows < 3) {
-      throw new BlockConfigError(
-        `input ${inputName(sig.info)} has shape ${formatShape(sig.shape)}; ArtifactRejection ` +
-          "judges windows [L, C] with L ≥ 3: put a SlidingWindow before it",
-      );
-    }
-    let kernel: ArtifactKernel;
-    try {
-      kernel = new ArtifactKernel({
-        rows,
-        channels: cols,
-        ...(p.RailLow !== undefined ? { railLow: p.RailLow } : {}),
-        ...(p.RailHigh !== undefined ? { railHigh: p.RailHigh } : {}),
-        clipTolerance: p.ClipTolerance,
-        clipFraction: p.ClipFraction,
-        flatThreshold: p.FlatThreshold,
-        jumpFactor: p.JumpFactor,
-        ...(p.DriftThreshold !== undefined ? { driftThreshold: p.DriftThreshold } : {}),
-        hard: p.Mode === "hard",
-      });
-    } catch (e) {
-      throw new BlockConfigError(`cannot create the artifact rules: ${errorMessage(e)}`);
-    }
-    const clean = ctx.output(sig.shape, "clean");
-    const mask = ctx.output(vectorShape(cols), "mask");
-    const text = new TextThrottle(0.5);
-
-    const summary = (): string => {
-      const total = [0, 0, 0, 0, 0, 0];
-      const bad: string[] = [];
-      for (let c = 0; c < cols; c++) {
-        for (let r = 0; r < 6; r++) total[r]! += kernel.counter(c, r);
-        if (kernel.counter(c, 5) > 0 && bad.length < 4) {
-          const why = SHORT.map((s, r) => [s, kernel.counter(c, r)] as const)
-            .filter(([, v]) => v > 0)
-            .map(([s, v]) => `${s} ${v}`)
-            .join(" ");
-          bad.push(`ch${c}: ${why}`);
-        }
-      }
-      const reasons = SHORT.map((s, r) => `${s} ${total[r]}`).join(", ");
-      const cells = kernel.windows() * cols;
-      return (
-        `rejected ${total[5]} of ${cells} channel-windows (${reasons})` +
-        (bad.length > 0
-          ? `; ${bad.join("; ")}${total[5]! > 0 && bad.length === 4 ? "; …" : ""}`
-          : "")
-      );
-    };
-    ctx.setText(summary());
-
-    let disposed = false;
+    const sig = windowInput(ctx);
+    const run = new ArtifactRun(ctx, createKernel(p, sig.shape.rows, sig.shape.cols), sig.shape);
     return {
       process(f) {
-        const n = f.n;
-        if (n === 0) return;
-        const co = clean.frame(n);
-        const mo = mask.frame(n);
-        kernel.process(f.v, n, co.v, mo.v);
-        const ft = f.t;
-        for (let e = 0; e < n; e++) {
-          co.t[e] = ft[e]!;
-          mo.t[e] = ft[e]!;
-        }
-        clean.emit(co);
-        mask.emit(mo);
-        // The status line is rebuilt at most every 0.5 s of pipeline time, and when it stops.
-        if (text.due(ft[n - 1]!)) ctx.setText(summary());
+        run.process(f);
       },
       stop() {
-        if (!disposed) ctx.setText(summary());
+        run.stop();
       },
       reset() {
-        kernel.reset();
-        text.reset();
-        ctx.setText(summary());
+        run.reset();
       },
       actions: {
         resetCounters: {
           label: "Reset counters",
           description:
             "Zeroes the counters per reason and channel (the learned auto rails are kept)",
-          run() {
-            kernel.resetCounters();
-            ctx.setText(summary());
-            return "counters reset";
-          },
+          run: () => run.resetCounters(),
         },
         counters: {
           label: "Counters per channel",
           description: "Windows rejected per channel and per reason since the last reset",
-          run() {
-            const lines = [
-              `windows ${kernel.windows()}`,
-              `channel,${ARTIFACT_REASONS.join(",")},rejected`,
-            ];
-            for (let c = 0; c < cols; c++) {
-              const row = [0, 1, 2, 3, 4, 5].map((r) => kernel.counter(c, r));
-              lines.push(`${c},${row.join(",")}`);
-            }
-            return lines.join("\n");
-          },
+          run: () => run.counters(),
         },
       },
       dispose() {
-        disposed = true;
-        kernel.dispose();
+        run.dispose();
       },
     };
   },
