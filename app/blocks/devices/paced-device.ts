@@ -17,6 +17,7 @@ import {
   type BlockContext,
   type BlockInstance,
   type Frame,
+  type OutputPort,
   type PortMeta,
   type Shape,
 } from "../../engine";
@@ -90,119 +91,185 @@ export function unreachableMessage(device: string, target: string): string {
   );
 }
 
-/** The instance of a timer-paced device block (see the file comment). */
-export function pacedDevice(ctx: BlockContext, o: PacedDeviceOptions): BlockInstance {
-  const out = ctx.output(o.shape, o.port, o.meta);
-  const size = shapeSize(o.shape);
-  const maxQueue = Math.max(1, o.maxQueue ?? 15);
-  const queue = new Float64Array(maxQueue * size);
-  let qHead = 0;
-  let qLen = 0;
-  const held = new Float64Array(size);
-  let streaming = false;
-  let phaseText = "stopped";
-  let samples = 0;
-  let dropped = 0;
-  let conn: DeviceConnection | undefined;
-  const throttle = new TextThrottle(0.5);
-  let lastText = "";
+/** The samples waiting for ticks: a ring of `capacity` samples of `size` values each. */
+class SampleQueue {
+  private readonly data: Float64Array;
+  private head = 0;
+  private length = 0;
 
-  const refresh = (): void => {
-    let text = phaseText;
-    if (samples > 0) text += ` · ${plural(samples, "sample")}`;
-    if (dropped > 0) text += ` · ${dropped} dropped (queue of ${maxQueue})`;
-    if (text !== lastText) {
-      lastText = text;
-      ctx.setText(text);
+  constructor(
+    readonly capacity: number,
+    private readonly size: number,
+  ) {
+    this.data = new Float64Array(capacity * size);
+  }
+
+  /** Appends a sample from `values[offset…]`; when full, drops the oldest first and says so. */
+  push(values: ArrayLike<number>, offset: number): boolean {
+    const { capacity, size, data } = this;
+    let dropped = false;
+    if (this.length === capacity) {
+      this.head = (this.head + 1) % capacity;
+      this.length--;
+      dropped = true;
     }
-  };
+    const at = ((this.head + this.length) % capacity) * size;
+    for (let k = 0; k < size; k++) data[at + k] = values[offset + k]!;
+    this.length++;
+    return dropped;
+  }
 
-  const sink: DeviceSampleSink = {
-    push(values, offset = 0) {
-      if (qLen === maxQueue) {
-        qHead = (qHead + 1) % maxQueue;
-        qLen--;
-        dropped++;
-      }
-      const at = ((qHead + qLen) % maxQueue) * size;
-      for (let k = 0; k < size; k++) queue[at + k] = values[offset + k]!;
-      qLen++;
-      samples++;
-    },
-    state(phase, text) {
-      streaming = phase === "streaming";
-      if (!streaming) {
-        qHead = 0;
-        qLen = 0;
-        held.fill(0);
-      }
-      phaseText = text;
-      refresh();
-    },
-    warn(message) {
-      ctx.warn(`${o.device}: ${message}`);
-    },
-  };
+  /** Moves the oldest sample into `into`; nothing when the queue is empty. */
+  shift(into: Float64Array): void {
+    if (this.length === 0) return;
+    const { size, data } = this;
+    const at = this.head * size;
+    for (let k = 0; k < size; k++) into[k] = data[at + k]!;
+    this.head = (this.head + 1) % this.capacity;
+    this.length--;
+  }
 
-  const emit = (f: Frame): void => {
+  clear(): void {
+    this.head = 0;
+    this.length = 0;
+  }
+}
+
+/** A timer-paced device block at run time: the link, the queue, the held sample, the status. */
+class PacedDevice {
+  private readonly out: OutputPort;
+  private readonly size: number;
+  private readonly queue: SampleQueue;
+  /** The sample every tick emits: the last one taken from the queue, zeros when not streaming. */
+  private readonly held: Float64Array;
+  private streaming = false;
+  private phaseText: string;
+  private samples = 0;
+  private dropped = 0;
+  private conn: DeviceConnection | undefined;
+  private readonly throttle = new TextThrottle(0.5);
+  private lastText = "";
+  /** What the protocol module pushes into. */
+  private readonly sink: DeviceSampleSink;
+
+  constructor(
+    private readonly ctx: BlockContext,
+    private readonly o: PacedDeviceOptions,
+  ) {
+    this.out = ctx.output(o.shape, o.port, o.meta);
+    this.size = shapeSize(o.shape);
+    this.queue = new SampleQueue(Math.max(1, o.maxQueue ?? 15), this.size);
+    this.held = new Float64Array(this.size);
+    this.sink = {
+      push: (values, offset = 0) => this.push(values, offset),
+      state: (phase, text) => this.setState(phase, text),
+      warn: (message) => ctx.warn(`${o.device}: ${message}`),
+    };
+    this.phaseText = o.protocol ? `${o.device}: not started` : `${o.device}: no protocol yet`;
+    this.refresh();
+  }
+
+  start(): void {
+    const o = this.o;
+    if (!o.protocol) {
+      this.phaseText = `not reachable: ${o.target} (sending zeros; --simulate-devices simulates it)`;
+      this.refresh();
+      this.ctx.warn(unreachableMessage(o.device, o.target));
+      return;
+    }
+    this.phaseText = `connecting to ${o.target}…`;
+    this.refresh();
+    this.conn = o.protocol.open(this.ctx, this.sink);
+  }
+
+  /** One event per tick: the oldest waiting sample, else the held one again. */
+  process(f: Frame): void {
     const n = f.n;
     if (n === 0) return;
+    const { out, held, size } = this;
     const e = out.frame(n);
     e.t.set(f.t.subarray(0, n));
     const v = e.v;
     for (let i = 0; i < n; i++) {
-      if (streaming && qLen > 0) {
-        const at = qHead * size;
-        for (let k = 0; k < size; k++) held[k] = queue[at + k]!;
-        qHead = (qHead + 1) % maxQueue;
-        qLen--;
-      }
+      if (this.streaming) this.queue.shift(held);
       v.set(held, i * size);
     }
     out.emit(e);
-    if (throttle.due(f.t[n - 1]!)) refresh();
-  };
+    if (this.throttle.due(f.t[n - 1]!)) this.refresh();
+  }
 
-  phaseText = o.protocol ? `${o.device}: not started` : `${o.device}: no protocol yet`;
-  refresh();
+  stop(): void {
+    this.close();
+    this.streaming = false;
+    this.held.fill(0);
+    this.queue.clear();
+    if (this.o.protocol) this.phaseText = "stopped";
+    this.refresh();
+  }
 
+  reset(): void {
+    this.samples = 0;
+    this.dropped = 0;
+    this.held.fill(0);
+    this.queue.clear();
+    this.throttle.reset();
+    this.refresh();
+  }
+
+  dispose(): void {
+    this.close();
+  }
+
+  private close(): void {
+    this.conn?.close();
+    this.conn = undefined;
+  }
+
+  private push(values: ArrayLike<number>, offset: number): void {
+    if (this.queue.push(values, offset)) this.dropped++;
+    this.samples++;
+  }
+
+  private setState(phase: "connecting" | "streaming" | "lost", text: string): void {
+    this.streaming = phase === "streaming";
+    if (!this.streaming) {
+      this.queue.clear();
+      this.held.fill(0);
+    }
+    this.phaseText = text;
+    this.refresh();
+  }
+
+  /** The status line (set only when its text changes). */
+  private refresh(): void {
+    let text = this.phaseText;
+    if (this.samples > 0) text += ` · ${plural(this.samples, "sample")}`;
+    if (this.dropped > 0) text += ` · ${this.dropped} dropped (queue of ${this.queue.capacity})`;
+    if (text !== this.lastText) {
+      this.lastText = text;
+      this.ctx.setText(text);
+    }
+  }
+}
+
+/** The instance of a timer-paced device block (see the file comment). */
+export function pacedDevice(ctx: BlockContext, o: PacedDeviceOptions): BlockInstance {
+  const device = new PacedDevice(ctx, o);
   return {
     start() {
-      if (!o.protocol) {
-        phaseText = `not reachable: ${o.target} (sending zeros; --simulate-devices simulates it)`;
-        refresh();
-        ctx.warn(unreachableMessage(o.device, o.target));
-        return;
-      }
-      phaseText = `connecting to ${o.target}…`;
-      refresh();
-      conn = o.protocol.open(ctx, sink);
+      device.start();
     },
     process(f) {
-      emit(f);
+      device.process(f);
     },
     stop() {
-      conn?.close();
-      conn = undefined;
-      streaming = false;
-      held.fill(0);
-      qHead = 0;
-      qLen = 0;
-      if (o.protocol) phaseText = "stopped";
-      refresh();
+      device.stop();
     },
     reset() {
-      samples = 0;
-      dropped = 0;
-      held.fill(0);
-      qHead = 0;
-      qLen = 0;
-      throttle.reset();
-      refresh();
+      device.reset();
     },
     dispose() {
-      conn?.close();
-      conn = undefined;
+      device.dispose();
     },
   };
 }
