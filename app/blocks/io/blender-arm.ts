@@ -17,7 +17,7 @@ import {
 import { inputName, vectorInput } from "../shared/inputs";
 import { plural, TextThrottle } from "../shared/text";
 import { asciiBytes, BLENDER_SIZE, blenderCommand, blenderText } from "./blender-format";
-import { endpointText, hostParam, portParam, udpBridge, WarnLimiter } from "./udp-common";
+import { endpointText, hostParam, portParam, udpBridge, WarnLimiter, NO_UDP } from "./udp-common";
 
 const params = z.strictObject({
   Host: hostParam("The computer running the Blender scene: an IP address or host name"),
@@ -107,9 +107,7 @@ export const BlenderArm = defineBlock({
     const bridge = udpBridge(ctx);
     const describe = (): void => {
       if (!bridge) {
-        ctx.setText(
-          `UDP is unavailable here (the browser build has no network sockets): ${plural(notSent, "command")} not sent`,
-        );
+        ctx.setText(`${NO_UDP}: ${plural(notSent, "command")} not sent`);
         return;
       }
       const err = failed > 0 ? `, ${failed} failed (${lastError})` : "";
@@ -131,9 +129,7 @@ export const BlenderArm = defineBlock({
     return {
       start() {
         if (!bridge) {
-          ctx.warn(
-            "UDP is unavailable here (the browser build has no network sockets): the Blender arm gets nothing",
-          );
+          ctx.warn(`${NO_UDP}: the Blender arm gets nothing`);
           return;
         }
         if (socket) return;

@@ -11,7 +11,7 @@ import { ACTUATION_SIZE, controlInput, describeControl, toActuation } from "../c
 import { inputName, vectorInput, type SignalInput } from "../shared/inputs";
 import { plural, TextThrottle } from "../shared/text";
 import { guiActivations, guiArv, guiRawEmg } from "./hannes-protocol";
-import { endpointText, hostParam, portParam, udpBridge, WarnLimiter } from "./udp-common";
+import { endpointText, hostParam, portParam, udpBridge, WarnLimiter, NO_UDP } from "./udp-common";
 
 const params = z.strictObject({
   Host: hostParam("The computer running IIT's Hannes GUI (the virtual arm)"),
@@ -141,9 +141,7 @@ export const HannesGUI = defineBlock({
     const bridge = udpBridge(ctx);
     const describe = (): void => {
       if (!bridge) {
-        ctx.setText(
-          `UDP is unavailable here (the browser build has no network sockets): ${plural(notSent, "event")} not sent`,
-        );
+        ctx.setText(`${NO_UDP}: ${plural(notSent, "event")} not sent`);
         return;
       }
       let s = `→ ${dest}, ${reads}: ${plural(counts[0]!, "activation")}`;
@@ -168,9 +166,7 @@ export const HannesGUI = defineBlock({
     return {
       start() {
         if (!bridge) {
-          ctx.warn(
-            "UDP is unavailable here (the browser build has no network sockets): the Hannes GUI gets nothing",
-          );
+          ctx.warn(`${NO_UDP}: the Hannes GUI gets nothing`);
           return;
         }
         if (socket) return;

@@ -15,7 +15,7 @@ import type {
 } from "../../engine";
 import { plural, TextThrottle } from "../shared/text";
 import { decodeHannesEmg } from "./hannes-protocol";
-import { endpointText, WarnLimiter } from "./udp-common";
+import { endpointText, WarnLimiter, NO_UDP } from "./udp-common";
 
 export interface HannesReceiverOptions {
   host: string;
@@ -117,9 +117,7 @@ export class HannesReceiverRun {
   private start(): void {
     const bridge = this.bridge;
     if (!bridge) {
-      this.ctx.warn(
-        "UDP is unavailable here (the browser build has no network sockets): this block receives nothing",
-      );
+      this.ctx.warn(`${NO_UDP}: this block receives nothing`);
       return;
     }
     if (this.socket) return;

@@ -29,14 +29,14 @@ export const byteParam = (what: string) => z.number().int().min(0).max(255).desc
 export const endpointText = (host: string, port: number): string =>
   host.includes(":") ? `[${host}]:${port}` : `${host}:${port}`;
 
+/** The start of every message saying a block has no UDP here. */
+export const NO_UDP = "UDP is unavailable here (the browser build has no network sockets)";
+
 /** The host's UDP bridge, or undefined after saying in the block's status why there is none. */
 export function udpBridge(ctx: BlockContext): UdpBridge | undefined {
   const udp = ctx.io.udp;
   if (udp) return udp;
-  ctx.setText(
-    "UDP is unavailable here (the browser build has no network sockets): run the pipeline " +
-      "with the desktop app or `mosaic run`",
-  );
+  ctx.setText(`${NO_UDP}: run the pipeline with the desktop app or \`mosaic run\``);
   return undefined;
 }
 

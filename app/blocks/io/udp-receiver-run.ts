@@ -21,7 +21,7 @@ import {
   newHeader,
   valueSize,
 } from "./udp-format";
-import { endpointText, WarnLimiter } from "./udp-common";
+import { endpointText, WarnLimiter, NO_UDP } from "./udp-common";
 
 /** What the block's params decide (checked by the block before the run starts). */
 export interface UdpReceiverSettings {
@@ -101,9 +101,7 @@ export class UdpReceiverRun {
   private start(): void {
     const bridge = this.bridge;
     if (!bridge) {
-      this.ctx.warn(
-        "UDP is unavailable here (the browser build has no network sockets): this block receives nothing",
-      );
+      this.ctx.warn(`${NO_UDP}: this block receives nothing`);
       return;
     }
     if (this.socket) return;

@@ -7,7 +7,7 @@ import type { BlockContext, BlockInstance, Frame, UdpBridge, UdpSocketHandle } f
 import { formatCount, plural, TextThrottle } from "../shared/text";
 import type { RawEncoder, StreamlinedEncoder, ValueType } from "./udp-format";
 import type { Serializer } from "./udp-sender";
-import { WarnLimiter } from "./udp-common";
+import { WarnLimiter, NO_UDP } from "./udp-common";
 
 /** How one input is sent. */
 export interface Plan {
@@ -81,9 +81,7 @@ export class UdpSenderRun {
 
   private start(): void {
     if (!this.bridge) {
-      this.ctx.warn(
-        "UDP is unavailable here (the browser build has no network sockets): this block sends nothing",
-      );
+      this.ctx.warn(`${NO_UDP}: this block sends nothing`);
       return;
     }
     if (this.socket) return;
@@ -176,9 +174,7 @@ export class UdpSenderRun {
 
   private describe(): void {
     if (this.unavailable) {
-      this.ctx.setText(
-        `UDP is unavailable here (the browser build has no network sockets): ${plural(this.notSent, "event")} not sent`,
-      );
+      this.ctx.setText(`${NO_UDP}: ${plural(this.notSent, "event")} not sent`);
       return;
     }
     const err = this.failed > 0 ? `, ${formatCount(this.failed)} not sent (${this.lastError})` : "";
