@@ -20,6 +20,10 @@ const common = {
   outExtension: { ".js": ".mjs" },
   sourcemap: "linked",
   logLevel: "warning",
+  // No comments nor indentation in what V8 keeps as source (one copy per thread that loads a
+  // chunk; a comment's "µ" or "—" made a whole chunk a two-byte string): ~2 MiB less per worker.
+  // Names stay, and the linked source maps give file:line.
+  minifyWhitespace: true,
   banner: {
     js: "import { createRequire as __cr } from 'node:module'; const require = __cr(import.meta.url);",
   },

@@ -27,10 +27,16 @@ export interface Machine {
   gitDirty: boolean | null;
 }
 
-/** dist/cli.mjs: this bundle itself when it is dist/cli.mjs, else the repository's dist. */
+/**
+ * dist/cli.mjs: beside this bundle or one folder up (the bench is a chunk the CLI loads on
+ * demand, dist/chunks/), else the repository's dist.
+ */
 export function findCli(): string {
   const here = fileURLToPath(import.meta.url);
-  if (here.endsWith(".mjs")) return join(dirname(here), "cli.mjs");
+  if (here.endsWith(".mjs")) {
+    const near = [dirname(here), dirname(dirname(here))].map((d) => join(d, "cli.mjs"));
+    return near.find((f) => existsSync(f)) ?? near[0]!;
+  }
   return join(findRoot(dirname(here)), "dist", "cli.mjs");
 }
 

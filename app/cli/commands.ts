@@ -14,14 +14,9 @@ import { readFileSync, statSync, writeFileSync } from "node:fs";
 import { dirname, join, resolve } from "node:path";
 import { parseArgs } from "node:util";
 import { formatDiagnostic } from "../engine/diagnostics";
-import { PipelineDocument } from "../engine/pipeline/document";
 import type { SimulateOptions } from "../engine/pipeline/simulate";
 import { Host, webRoot } from "../host/host";
 import { serveStatic } from "../host/web-server";
-import { runBench } from "./bench";
-import { cmdNewBlock, newBlockHelp } from "./new-block";
-import { cmdRepair, repairHelp } from "./repair";
-import { cmdSimulate, simulateHelp } from "./simulate";
 import { RunConsole, type RunEnd } from "./run-console";
 import {
   hostOptions,
@@ -30,11 +25,19 @@ import {
   simulateOption,
   type RunOptions,
 } from "./run-options";
-import { cmdTestBlock, testBlockHelp } from "./test-block";
 
 const VERSION = "0.1.0";
 
-const HELP = `mosaic ${VERSION} — run MOSAIC pipelines headless
+/**
+ * The whole help. The commands' modules give their own lines; they are loaded only here and when
+ * their command runs, so that `mosaic run` keeps the block catalog, the YAML and schema libraries
+ * and the bench out of the main thread (less memory, faster start).
+ */
+async function helpText(): Promise<string> {
+  const [{ testBlockHelp }, { simulateHelp }, { repairHelp }, { newBlockHelp }] = await Promise.all(
+    [import("./test-block"), import("./simulate"), import("./repair"), import("./new-block")],
+  );
+  return `mosaic ${VERSION} — run MOSAIC pipelines headless
 
 Usage:
   mosaic validate FILE... [--simulate-devices [--keep-network]]
@@ -98,6 +101,7 @@ ${repairHelp()}
 ${newBlockHelp()}
   mosaic --help | --version
 `;
+}
 
 function out(s: string): void {
   process.stdout.write(s + "\n");
@@ -178,7 +182,7 @@ async function cmdFormat(args: string[]): Promise<number> {
     let formatted: string;
     try {
       source = readFileSync(f, "utf8");
-      const doc = PipelineDocument.parse(source, f);
+      const doc = (await import("../engine/pipeline/document")).PipelineDocument.parse(source, f);
       doc.normalize();
       formatted = doc.toString();
     } catch (e) {
@@ -413,7 +417,7 @@ function isArgsError(e: unknown): e is Error {
 export async function main(argv: string[]): Promise<number> {
   const [cmd, ...rest] = argv;
   if (cmd !== undefined && (rest.includes("--help") || rest.includes("-h"))) {
-    out(HELP);
+    out(await helpText());
     return 0;
   }
   try {
@@ -431,7 +435,7 @@ async function dispatch(cmd: string | undefined, rest: string[]): Promise<number
     case "-h":
     case "--help":
     case "help":
-      out(HELP);
+      out(await helpText());
       return cmd === undefined ? 2 : 0;
     case "-v":
     case "--version":
@@ -440,23 +444,23 @@ async function dispatch(cmd: string | undefined, rest: string[]): Promise<number
     case "validate":
       return cmdValidate(rest);
     case "test-block":
-      return cmdTestBlock(rest, out, err);
+      return (await import("./test-block")).cmdTestBlock(rest, out, err);
     case "format":
       return cmdFormat(rest);
     case "run":
       return cmdRun(rest);
     case "bench":
-      return runBench(rest);
+      return (await import("./bench")).runBench(rest);
     case "web":
       return cmdWeb(rest);
     case "serve":
       return cmdServe(rest);
     case "simulate":
-      return cmdSimulate(rest, out, err);
+      return (await import("./simulate")).cmdSimulate(rest, out, err);
     case "repair":
-      return cmdRepair(rest, out, err);
+      return (await import("./repair")).cmdRepair(rest, out, err);
     case "new-block":
-      return cmdNewBlock(rest, out, err);
+      return (await import("./new-block")).cmdNewBlock(rest, out, err);
     default:
       err(
         `mosaic: unknown command '${cmd}' (commands: validate, format, run, web, serve, bench, simulate, repair, new-block; see mosaic --help)`,
