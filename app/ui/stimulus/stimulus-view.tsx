@@ -50,7 +50,8 @@ export function StimulusView({
     (t) => t?.blocks.find((b) => b.name === block.name)?.text ?? "",
     Object.is,
   );
-  // Smooth countdown between data messages (20 Hz), unless reduced motion is asked for.
+  // The countdown moves between data messages: a render at 10 Hz while a phase runs (reduced
+  // motion stops only the CSS transitions, styles.css).
   useCountdownTick(visible, live.phase);
   const { running, phase, label, left, progress, count } = stimulusState(
     live,
