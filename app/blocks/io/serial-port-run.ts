@@ -50,7 +50,7 @@ export class SerialPortRun {
         this.refresh();
       },
       process: (frame: Frame) => this.process(frame),
-      reset: () => this.decoder.reset(),
+      reset: () => this.reset(),
       dispose: () => this.close(),
       actions: {
         info: {
@@ -102,6 +102,15 @@ export class SerialPortRun {
       handle.write(this.encoder.encode(frame.v.subarray(e * width, (e + 1) * width)));
       this.written++;
     }
+    this.refresh();
+  }
+
+  /** As if just created, the port left as it is: a partial frame dropped, every count zero. */
+  private reset(): void {
+    this.decoder.reset();
+    Object.assign(this.decoder.stats, { frames: 0, malformed: 0, skipped: 0, lastProblem: "" });
+    this.written = 0;
+    this.writeErrors = 0;
     this.refresh();
   }
 

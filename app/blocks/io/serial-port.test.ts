@@ -103,6 +103,26 @@ describe("SerialPort", () => {
     h.instance.dispose?.();
   });
 
+  test("reset drops a partial line and zeroes every count; the port stays open", async () => {
+    const { bridge, port } = fakeBridge();
+    const h = await BlockHarness.create(
+      SerialPort,
+      { Path: "COM4", Channels: 1 },
+      { io: { serial: bridge }, inputs: [{ shape: vectorShape(1), rate: 10 }] },
+    );
+    h.start();
+    port.data(ascii("1\nnope\n2\n3"));
+    h.push(vectors([1], [[4]]));
+    expect(h.text).toMatch(/^COM4 open @ 115200 Bd · 2 frames · 1 written · 1 malformed/);
+    h.instance.reset?.();
+    expect(h.text).toBe("COM4 open @ 115200 Bd · 0 frames");
+    expect(port.closed).toBe(0);
+    // The "3" before the reset is not glued to the next line.
+    port.data(ascii("5\n"));
+    expect(h.output().v.at(-1)).toEqual([5]);
+    expect(h.text).toBe("COM4 open @ 115200 Bd · 1 frames");
+  });
+
   test("binary frames decode; writes use the same framing", async () => {
     const { bridge, port } = fakeBridge();
     const framing = {
