@@ -2,6 +2,7 @@ import { z } from "zod";
 import {
   BlockConfigError,
   closest,
+  type BlockContext,
   defineBlock,
   formatShape,
   legacyPair,
@@ -10,8 +11,9 @@ import {
   matrixShape,
   type Shape,
 } from "../../engine";
-import { flattenRows, matrixParam, rotationRPY } from "../shared/linalg";
+import { matrixParam } from "../shared/linalg";
 import { inputName, signalInput, type SignalInput } from "../shared/inputs";
+import { VectorialFunctionRun } from "./vectorial-function-run";
 
 const OPERATIONS = [
   "rotate",
@@ -24,7 +26,7 @@ const OPERATIONS = [
   "matmul",
   "integrate",
 ] as const;
-type Operation = (typeof OPERATIONS)[number];
+export type Operation = (typeof OPERATIONS)[number];
 
 /** Operations that need a second input (sample-and-hold operand). */
 const BINARY: ReadonlySet<Operation> = new Set(["add", "subtract", "cross", "dot"]);
@@ -77,7 +79,72 @@ const params = z.strictObject({
     ),
 });
 
-type Params = z.output<typeof params>;
+export type VectorialFunctionParams = z.output<typeof params>;
+type Params = VectorialFunctionParams;
+
+/** Binary operations need a second input, and only they and wrench may have one; returns it. */
+function checkInputs(ctx: BlockContext, op: Operation, a: SignalInput): SignalInput | null {
+  const binary = BINARY.has(op);
+  const n = ctx.inputs.length;
+  if (binary && n !== 2) {
+    throw new BlockConfigError(
+      `${op} needs two inputs (${op === "subtract" ? "first − second" : "first and second"}); ` +
+        `it has only ${inputName(a.info)}`,
+      "Operation",
+    );
+  }
+  if (!binary && op !== "wrench" && n === 2) {
+    throw new BlockConfigError(
+      `${op} takes one input; remove the second input ${inputName(ctx.inputs[1]!)} (only ` +
+        "add, subtract, cross, dot and wrench use a second input)",
+      "Operation",
+    );
+  }
+  return n === 2 ? signalInput(ctx, 1) : null;
+}
+
+/** Matrix only for matmul and wrench; Roll, Pitch and Yaw only for rotate. */
+function checkParamUse(op: Operation, p: Params): void {
+  if (p.Matrix !== undefined && op !== "matmul" && op !== "wrench") {
+    throw new BlockConfigError(`Matrix is used only by matmul and wrench, not by ${op}`, "Matrix");
+  }
+  if (op !== "rotate") {
+    for (const k of ["Roll", "Pitch", "Yaw"] as const) {
+      if (p[k] !== 0) throw new BlockConfigError(`${k} is used only by rotate, not by ${op}`, k);
+    }
+  }
+}
+
+/** wrench's Matrix must be 6 × 6. */
+function checkWrenchMatrix(m: number[][]): void {
+  if (m.length !== 6 || m[0]!.length !== 6) {
+    throw new BlockConfigError(
+      `Matrix is ${m.length} × ${m[0]!.length}; wrench needs a 6 × 6 matrix`,
+      "Matrix",
+    );
+  }
+}
+
+/** matmul needs a K × C Matrix (C: the input's width); the output is [R, K]. */
+function matmulShape(a: SignalInput, m: number[][] | undefined): Shape {
+  const { rows, cols } = a.shape;
+  const name = inputName(a.info);
+  if (m === undefined) {
+    throw new BlockConfigError(
+      `matmul needs Matrix: K rows of ${cols} numbers (the width of input ${name}); MOSAIC's ` +
+        "matrix_multiply loaded it from a file in its control panel",
+      "Matrix",
+    );
+  }
+  if (m[0]!.length !== cols) {
+    throw new BlockConfigError(
+      `Matrix is ${m.length} × ${m[0]!.length}, but input ${name} has width ${cols}; ` +
+        `expected rows of ${cols} numbers`,
+      "Matrix",
+    );
+  }
+  return matrixShape(rows, m.length);
+}
 
 /** Shape rules of each operation; returns the output shape or throws naming the input. */
 function checkShapes(op: Operation, a: SignalInput, b: SignalInput | null, p: Params): Shape {
@@ -110,12 +177,7 @@ function checkShapes(op: Operation, a: SignalInput, b: SignalInput | null, p: Pa
       if (b && (b.shape.rows !== 1 || b.shape.cols !== 3)) {
         badB("[1, 3]: the point r = [x, y, z] to move the torque reference to");
       }
-      if (p.Matrix && (p.Matrix.length !== 6 || p.Matrix[0]!.length !== 6)) {
-        throw new BlockConfigError(
-          `Matrix is ${p.Matrix.length} × ${p.Matrix[0]!.length}; wrench needs a 6 × 6 matrix`,
-          "Matrix",
-        );
-      }
+      if (p.Matrix) checkWrenchMatrix(p.Matrix);
       return a.shape;
     case "add":
     case "subtract":
@@ -136,24 +198,8 @@ function checkShapes(op: Operation, a: SignalInput, b: SignalInput | null, p: Pa
         badB(`[1, ${cols}], the width of the first input ${name}`);
       }
       return matrixShape(rows, 1);
-    case "matmul": {
-      const m = p.Matrix;
-      if (m === undefined) {
-        throw new BlockConfigError(
-          `matmul needs Matrix: K rows of ${cols} numbers (the width of input ${name}); MOSAIC's ` +
-            "matrix_multiply loaded it from a file in its control panel",
-          "Matrix",
-        );
-      }
-      if (m[0]!.length !== cols) {
-        throw new BlockConfigError(
-          `Matrix is ${m.length} × ${m[0]!.length}, but input ${name} has width ${cols}; ` +
-            `expected rows of ${cols} numbers`,
-          "Matrix",
-        );
-      }
-      return matrixShape(rows, m.length);
-    }
+    case "matmul":
+      return matmulShape(a, p.Matrix);
     case "integrate":
       return a.shape;
   }
@@ -229,224 +275,9 @@ export const VectorialFunction = defineBlock({
   create(ctx, p) {
     const op: Operation = p.Operation;
     const a = signalInput(ctx, 0);
-    const binary = BINARY.has(op);
-    const n = ctx.inputs.length;
-    if (binary && n !== 2) {
-      throw new BlockConfigError(
-        `${op} needs two inputs (${op === "subtract" ? "first − second" : "first and second"}); ` +
-          `it has only ${inputName(a.info)}`,
-        "Operation",
-      );
-    }
-    if (!binary && op !== "wrench" && n === 2) {
-      throw new BlockConfigError(
-        `${op} takes one input; remove the second input ${inputName(ctx.inputs[1]!)} (only ` +
-          "add, subtract, cross, dot and wrench use a second input)",
-        "Operation",
-      );
-    }
-    const b = n === 2 ? signalInput(ctx, 1) : null;
-    if (p.Matrix !== undefined && op !== "matmul" && op !== "wrench") {
-      throw new BlockConfigError(
-        `Matrix is used only by matmul and wrench, not by ${op}`,
-        "Matrix",
-      );
-    }
-    if (op !== "rotate") {
-      for (const k of ["Roll", "Pitch", "Yaw"] as const) {
-        if (p[k] !== 0) throw new BlockConfigError(`${k} is used only by rotate, not by ${op}`, k);
-      }
-    }
+    const b = checkInputs(ctx, op, a);
+    checkParamUse(op, p);
     const outShape = checkShapes(op, a, b, p);
-    const out = ctx.output(outShape);
-    const { rows, cols } = a.shape;
-    const size = a.size;
-    const outStride = outShape.rows * outShape.cols;
-
-    // Second input: sample and hold.
-    const bSize = b?.size ?? 0;
-    const held = new Float64Array(bSize);
-    let seen = b === null;
-    const waiting = b ? `waiting for ${b.info.source}` : "";
-    ctx.setText(waiting);
-
-    // Rotation matrix / projection matrix.
-    const rot = new Float64Array(9);
-    const angles = { Roll: p.Roll, Pitch: p.Pitch, Yaw: p.Yaw };
-    rotationRPY(angles.Roll, angles.Pitch, angles.Yaw, rot);
-    const k = op === "matmul" ? outShape.cols : 6;
-    let mat = p.Matrix
-      ? flattenRows(p.Matrix)
-      : op === "wrench"
-        ? flattenRows([0, 1, 2, 3, 4, 5].map((i) => [0, 1, 2, 3, 4, 5].map((j) => +(i === j))))
-        : new Float64Array(0);
-    const w = new Float64Array(6);
-
-    // Integrator state.
-    const sum = op === "integrate";
-    const acc = new Float64Array(sum ? size : 0);
-    const prev = new Float64Array(sum ? size : 0);
-    let prevT = NaN;
-    const trapezoid = p.Integration === "trapezoid";
-
-    const compute = (v: Float64Array, src: number, t: number, o: Float64Array, dst: number) => {
-      switch (op) {
-        case "rotate":
-          for (let i = 0; i < size; i += 3) {
-            const x = v[src + i]!;
-            const y = v[src + i + 1]!;
-            const z = v[src + i + 2]!;
-            o[dst + i] = rot[0]! * x + rot[1]! * y + rot[2]! * z;
-            o[dst + i + 1] = rot[3]! * x + rot[4]! * y + rot[5]! * z;
-            o[dst + i + 2] = rot[6]! * x + rot[7]! * y + rot[8]! * z;
-          }
-          break;
-        case "norm":
-          for (let r = 0; r < rows; r++) {
-            let s = 0;
-            const off = src + r * cols;
-            for (let c = 0; c < cols; c++) s += v[off + c]! * v[off + c]!;
-            o[dst + r] = Math.sqrt(s);
-          }
-          break;
-        case "wrench":
-          for (let r = 0; r < rows; r++) {
-            const off = src + r * 6;
-            for (let i = 0; i < 6; i++) w[i] = v[off + i]!;
-            if (b) {
-              // τ − r × f
-              const fx = w[0]!;
-              const fy = w[1]!;
-              const fz = w[2]!;
-              w[3] = w[3]! - (held[1]! * fz - held[2]! * fy);
-              w[4] = w[4]! - (held[2]! * fx - held[0]! * fz);
-              w[5] = w[5]! - (held[0]! * fy - held[1]! * fx);
-            }
-            for (let i = 0; i < 6; i++) {
-              let s = 0;
-              for (let j = 0; j < 6; j++) s += mat[i * 6 + j]! * w[j]!;
-              o[dst + r * 6 + i] = s;
-            }
-          }
-          break;
-        case "add":
-        case "subtract": {
-          const sign = op === "add" ? 1 : -1;
-          const bStride = bSize === size ? 0 : cols; // 0: same shape; cols: one row for all
-          for (let r = 0; r < rows; r++) {
-            const off = r * cols;
-            const boff = bStride === 0 ? off : 0;
-            for (let c = 0; c < cols; c++) {
-              o[dst + off + c] = v[src + off + c]! + sign * held[boff + c]!;
-            }
-          }
-          break;
-        }
-        case "cross":
-          for (let r = 0; r < rows; r++) {
-            const off = src + r * 3;
-            const x = v[off]!;
-            const y = v[off + 1]!;
-            const z = v[off + 2]!;
-            o[dst + r * 3] = y * held[2]! - z * held[1]!;
-            o[dst + r * 3 + 1] = z * held[0]! - x * held[2]!;
-            o[dst + r * 3 + 2] = x * held[1]! - y * held[0]!;
-          }
-          break;
-        case "dot":
-          for (let r = 0; r < rows; r++) {
-            let s = 0;
-            const off = src + r * cols;
-            for (let c = 0; c < cols; c++) s += v[off + c]! * held[c]!;
-            o[dst + r] = s;
-          }
-          break;
-        case "matmul":
-          for (let r = 0; r < rows; r++) {
-            const off = src + r * cols;
-            for (let i = 0; i < k; i++) {
-              let s = 0;
-              const m = i * cols;
-              for (let c = 0; c < cols; c++) s += mat[m + c]! * v[off + c]!;
-              o[dst + r * k + i] = s;
-            }
-          }
-          break;
-        case "integrate": {
-          const first = Number.isNaN(prevT);
-          const dt = first ? 0 : t - prevT;
-          for (let i = 0; i < size; i++) {
-            const x = v[src + i]!;
-            if (!trapezoid) acc[i] = acc[i]! + x;
-            else if (dt > 0) acc[i] = acc[i]! + 0.5 * (x + prev[i]!) * dt;
-            prev[i] = x;
-            o[dst + i] = acc[i]!;
-          }
-          if (first || dt > 0) prevT = t;
-          break;
-        }
-      }
-    };
-
-    const setMatrix = (m: unknown): void => {
-      if (op !== "matmul" && op !== "wrench") {
-        throw new Error(`Matrix is used only by matmul and wrench, not by ${op}`);
-      }
-      const rowsM = m as number[][];
-      const want = op === "matmul" ? `${k} × ${cols}` : "6 × 6";
-      const wantCols = op === "matmul" ? cols : 6;
-      if (rowsM.length !== k || rowsM[0]!.length !== wantCols) {
-        throw new Error(
-          `Matrix must stay ${want} (the output width is fixed while running); got ` +
-            `${rowsM.length} × ${rowsM[0]!.length}`,
-        );
-      }
-      mat = flattenRows(rowsM);
-    };
-
-    return {
-      process(f, port) {
-        const nEv = f.n;
-        if (nEv === 0) return;
-        const v = f.v;
-        if (port === 1) {
-          const last = (nEv - 1) * bSize;
-          for (let i = 0; i < bSize; i++) held[i] = v[last + i]!;
-          if (!seen) {
-            seen = true;
-            ctx.setText("");
-          }
-          return;
-        }
-        if (!seen) return;
-        const o = out.frame(nEv);
-        const ft = f.t;
-        const ov = o.v;
-        for (let e = 0; e < nEv; e++) {
-          o.t[e] = ft[e]!;
-          compute(v, e * size, ft[e]!, ov, e * outStride);
-        }
-        out.emit(o);
-      },
-      reset() {
-        held.fill(0);
-        seen = b === null;
-        ctx.setText(waiting);
-        acc.fill(0);
-        prev.fill(0);
-        prevT = NaN;
-      },
-      setParam(name, value) {
-        if (name === "Matrix") {
-          setMatrix(value);
-          return;
-        }
-        if (name === "Roll" || name === "Pitch" || name === "Yaw") {
-          if (op !== "rotate") throw new Error(`${name} is used only by rotate, not by ${op}`);
-          angles[name] = value as number;
-          rotationRPY(angles.Roll, angles.Pitch, angles.Yaw, rot);
-        }
-      },
-    };
+    return new VectorialFunctionRun(ctx, p, a, b, outShape).instance();
   },
 });
