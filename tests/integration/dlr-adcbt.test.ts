@@ -235,7 +235,13 @@ Sine: { Type: SinGenerator, Inputs: [Timer], Params: [2], Path: ${JSON.stringify
     );
     const r = runCli(["run", file, "--json", "--duration", "2.5"], { timeoutMs: 60_000 });
     expect(r.code, r.stderr).toBe(0);
-    const text = statusTexts(r.stdout, "Board").find((t) => t !== "stopped") ?? "";
+    // The first reports may still say "connecting…" (the main thread loads the serial module on
+    // the first open); then the failure, and nothing else until the end.
+    const texts = statusTexts(r.stdout, "Board").filter(
+      (t) => t !== "stopped" && !t.startsWith("connecting to the DLR ADC/BT on serial port "),
+    );
+    const text = texts[0] ?? "";
+    expect(new Set(texts).size, texts.join(" | ")).toBe(1);
     expect(text).toMatch(
       new RegExp(
         `^cannot open ${port.replace(/[.*+?^${}()|[\]\\/]/g, "\\$&")}: no such device \\(unplugged\\?\\) — reconnecting every 1 s \\(sending zeros\\)`,
