@@ -235,10 +235,12 @@ Sine: { Type: SinGenerator, Inputs: [Timer], Params: [2], Path: ${JSON.stringify
     );
     const r = runCli(["run", file, "--json", "--duration", "2.5"], { timeoutMs: 60_000 });
     expect(r.code, r.stderr).toBe(0);
-    // The first reports may still say "connecting…" (the main thread loads the serial module on
-    // the first open); then the failure, and nothing else until the end.
+    // The first reports may still say "connecting…" or "opening…" (the main thread loads the
+    // serial module on the first open; under load that takes a few reports); then the failure, and
+    // nothing else until the end.
+    const transient = [`connecting to the DLR ADC/BT on serial port ${port} `, `opening ${port}…`];
     const texts = statusTexts(r.stdout, "Board").filter(
-      (t) => t !== "stopped" && !t.startsWith("connecting to the DLR ADC/BT on serial port "),
+      (t) => t !== "stopped" && !transient.some((x) => t.startsWith(x)),
     );
     const text = texts[0] ?? "";
     expect(new Set(texts).size, texts.join(" | ")).toBe(1);
