@@ -16,6 +16,7 @@ import { parseArgs } from "node:util";
 import { formatDiagnostic } from "../engine/diagnostics";
 import type { SimulateOptions } from "../engine/pipeline/simulate";
 import { Host, webRoot } from "../host/host";
+import type { Served } from "../host/serve";
 import { serveStatic } from "../host/web-server";
 import { RunConsole, type RunEnd } from "./run-console";
 import {
@@ -299,11 +300,8 @@ async function cmdWeb(args: string[]): Promise<number> {
       pipeline: { type: "string" },
     },
   });
-  const port = Number(values.port);
-  if (!Number.isInteger(port) || port < 0 || port > 65535) {
-    err(`mosaic web: --port must be a port number, not '${values.port}'`);
-    return 2;
-  }
+  const port = portNumber("web", values.port);
+  if (port === undefined) return 2;
   const root = webRoot();
   if (!root) {
     err("mosaic web: the browser build is missing (dist/web): run `npm run build` first");
@@ -320,15 +318,42 @@ async function cmdWeb(args: string[]): Promise<number> {
     server.url + (values.pipeline ? `?pipeline=${encodeURIComponent(values.pipeline)}` : "");
   out(`MOSAIC is at ${url}`);
   out("(the pipeline runs in the page; Ctrl-C stops this server)");
-  await new Promise<void>((r) => {
-    process.once("SIGINT", r);
-    process.once("SIGTERM", r);
-  });
+  await untilInterrupted();
   await server.close();
   return 0;
 }
 
-async function cmdServe(args: string[]): Promise<number> {
+/** `--port` as a port number; undefined (after saying why) when it is not one. */
+function portNumber(cmd: string, value: string): number | undefined {
+  const port = Number(value);
+  if (Number.isInteger(port) && port >= 0 && port <= 65535) return port;
+  err(`mosaic ${cmd}: --port must be a port number, not '${value}'`);
+  return undefined;
+}
+
+/** Resolves on Ctrl-C (SIGINT) or SIGTERM. */
+function untilInterrupted(): Promise<void> {
+  return new Promise<void>((r) => {
+    process.once("SIGINT", r);
+    process.once("SIGTERM", r);
+  });
+}
+
+/** What `mosaic serve` was asked to do, its options checked. */
+interface ServeArgs {
+  port: number;
+  host: string;
+  root: string;
+  dataDir: string | undefined;
+  /** The pipeline to load at start, and its text. */
+  file: string | undefined;
+  source: string | undefined;
+  start: boolean;
+  simulateDevices: boolean;
+}
+
+/** Parses and checks `mosaic serve`'s arguments; an exit code (after saying why) when they fail. */
+function parseServeArgs(args: string[]): ServeArgs | number {
   const { values, positionals } = parseArgs({
     args,
     allowPositionals: true,
@@ -345,11 +370,8 @@ async function cmdServe(args: string[]): Promise<number> {
     err(`mosaic serve: --data-dir ${dataDir} is not a folder`);
     return 2;
   }
-  const port = Number(values.port);
-  if (!Number.isInteger(port) || port < 0 || port > 65535) {
-    err(`mosaic serve: --port must be a port number, not '${values.port}'`);
-    return 2;
-  }
+  const port = portNumber("serve", values.port);
+  if (port === undefined) return 2;
   if (positionals.length > 1) {
     err("mosaic serve: give at most one pipeline file");
     return 2;
@@ -359,7 +381,6 @@ async function cmdServe(args: string[]): Promise<number> {
     err("mosaic serve: the browser build is missing (dist/web): run `npm run build` first");
     return 1;
   }
-  const { serve } = await import("../host/serve");
   const file = positionals[0] ? resolve(positionals[0]) : undefined;
   let source: string | undefined;
   if (file) {
@@ -370,43 +391,61 @@ async function cmdServe(args: string[]): Promise<number> {
       return 2;
     }
   }
+  return {
+    port,
+    host: values.host,
+    root,
+    dataDir,
+    file,
+    source,
+    start: !values["no-start"],
+    simulateDevices: values["simulate-devices"],
+  };
+}
+
+async function cmdServe(args: string[]): Promise<number> {
+  const a = parseServeArgs(args);
+  if (typeof a === "number") return a;
+  const { serve } = await import("../host/serve");
   let served;
   try {
     served = await serve({
-      webRoot: root,
-      port,
-      host: values.host,
+      webRoot: a.root,
+      port: a.port,
+      host: a.host,
       // The UI names its examples "pipelines/x.yaml", relative to the repository (= the web root).
-      pipelinesDir: join(dirname(root), ".."),
-      ...(dataDir !== undefined ? { dataDir } : {}),
+      pipelinesDir: join(dirname(a.root), ".."),
+      ...(a.dataDir !== undefined ? { dataDir: a.dataDir } : {}),
       onProblem: (m) => err(`mosaic serve: ${m}`),
     });
   } catch (e) {
     err(`mosaic serve: ${(e as Error).message}`);
     return 1;
   }
-  if (file && source !== undefined) {
-    const r = await served.hub.request({
-      type: "load",
-      file,
-      source,
-      ...(values["simulate-devices"] ? { simulateDevices: true } : {}),
-    });
-    for (const d of r.diagnostics ?? []) err(formatDiagnostic(d));
-    if (!r.ok) {
-      await served.close();
-      return 2;
-    }
-    if (!values["no-start"]) await served.hub.request({ type: "start" });
+  if (!(await loadFirstPipeline(served.hub, a))) {
+    await served.close();
+    return 2;
   }
   out(`MOSAIC is at ${served.url}`);
   out("(the engine runs in this process; open the URL, token included; Ctrl-C stops it)");
-  await new Promise<void>((r) => {
-    process.once("SIGINT", r);
-    process.once("SIGTERM", r);
-  });
+  await untilInterrupted();
   await served.close();
   return 0;
+}
+
+/** Loads (and unless --no-start starts) the pipeline given on the command line; false if invalid. */
+async function loadFirstPipeline(hub: Served["hub"], a: ServeArgs): Promise<boolean> {
+  if (!a.file || a.source === undefined) return true;
+  const r = await hub.request({
+    type: "load",
+    file: a.file,
+    source: a.source,
+    ...(a.simulateDevices ? { simulateDevices: true } : {}),
+  });
+  for (const d of r.diagnostics ?? []) err(formatDiagnostic(d));
+  if (!r.ok) return false;
+  if (a.start) await hub.request({ type: "start" });
+  return true;
 }
 
 /** A command's arguments that parseArgs refused (unknown option, missing value): its message, exit 2. */
