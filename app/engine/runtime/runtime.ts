@@ -419,6 +419,71 @@ class MinHeap {
   }
 }
 
+/** What instantiating the blocks produced (see `Runtime.instantiate`). */
+interface Instantiated {
+  diagnostics: Diagnostic[];
+  /** Blocks on other workers, instantiated only for planning (when no plan was given). */
+  planning: Node[];
+  planningByName: Map<string, Node>;
+}
+
+/** What this worker knows of a planned block: its shapes, metas and rate, by the plan. */
+function ghostOf(p: PlanBlock): Ghost {
+  return {
+    name: p.name,
+    type: p.type,
+    worker: p.worker,
+    desiredRate: p.desiredRate,
+    isTimer: p.isTimer,
+    outputs: new Map(p.outputs.map((o) => [o.name, o.shape])),
+    metas: ghostMetas(p),
+  };
+}
+
+/**
+ * A block's desired rate before it is created: its declared one, or that of its first timer input
+ * with a rate, or of its first input with a rate, or 0.
+ */
+function desiredRateOf(b: BlockSpec, inputs: readonly InputInfo[]): number {
+  let desired = b.desiredRate ?? 0;
+  if (b.desiredRate === undefined) {
+    const timerIn = inputs.find((i) => i.isTimer && i.rate > 0);
+    const anyIn = inputs.find((i) => i.rate > 0);
+    desired = (timerIn ?? anyIn)?.rate ?? 0;
+  }
+  return desired;
+}
+
+/** A `block-config` error about block `b`, at `pos` of `file` (and naming `param` if given). */
+function blockDiagnostic(
+  file: string,
+  b: BlockSpec,
+  pos: SourcePos,
+  message: string,
+  param?: string,
+): Diagnostic {
+  return {
+    severity: "error",
+    code: "block-config",
+    message: `block '${b.name}' (${b.type}): ${message}`,
+    file,
+    line: pos.line,
+    col: pos.col,
+    block: b.name,
+    ...(param !== undefined ? { param } : {}),
+  };
+}
+
+/**
+ * The diagnostic for block `b` whose `create` threw `e`: at the param a `BlockConfigError` names
+ * (else at the block's params, else at the block).
+ */
+function createFailure(file: string, b: BlockSpec, e: unknown): Diagnostic {
+  const param = e instanceof BlockConfigError ? e.param : undefined;
+  const pos = param !== undefined ? (b.paramPos[param.split(/[.[]/)[0]!] ?? b.paramsPos) : b.pos;
+  return blockDiagnostic(file, b, pos, errorMessage(e), param);
+}
+
 export class Runtime {
   readonly worker: string;
   readonly clock: Clock;
@@ -469,37 +534,38 @@ export class Runtime {
    */
   static async create(opts: RuntimeOptions): Promise<CreateResult> {
     const rt = new Runtime(opts.spec, opts);
+    const ghosts = new Map<string, Ghost>();
+    if (opts.plan) for (const p of opts.plan.blocks) ghosts.set(p.name, ghostOf(p));
+    const order = topoOrder(opts.spec);
+    const { diagnostics, planning, planningByName } = await rt.instantiate(opts, order, ghosts);
+    if (diagnostics.length > 0) {
+      for (const n of [...rt.nodes, ...planning]) rt.safeDispose(n);
+      return { runtime: undefined, diagnostics, plan: undefined };
+    }
+    // The plan, for workers that did not see the other blocks.
+    const plan: Plan = opts.plan ?? rt.planOf(order, planningByName);
+    for (const n of planning) rt.safeDispose(n);
+    if (!opts.plan) {
+      // Blocks placed on other workers are known from here on through the plan, like elsewhere.
+      for (const p of plan.blocks) if (!rt.byName.has(p.name)) ghosts.set(p.name, ghostOf(p));
+    }
+    rt.connectEdges(ghosts);
+    rt.openPathLogs();
+    for (const n of rt.nodes) if (n.finite) rt.finiteCount++;
+    return { runtime: rt, diagnostics, plan };
+  }
+
+  /**
+   * Creates the blocks in `order`, one after the other: this worker's into `nodes`, and, when no
+   * plan was given, the other workers' for planning only. A block that fails becomes a diagnostic.
+   */
+  private async instantiate(
+    opts: RuntimeOptions,
+    order: BlockSpec[],
+    ghosts: Map<string, Ghost>,
+  ): Promise<Instantiated> {
     const diagnostics: Diagnostic[] = [];
     const file = opts.spec.file;
-    const diag = (b: BlockSpec, pos: SourcePos, message: string, param?: string): void => {
-      diagnostics.push({
-        severity: "error",
-        code: "block-config",
-        message: `block '${b.name}' (${b.type}): ${message}`,
-        file,
-        line: pos.line,
-        col: pos.col,
-        block: b.name,
-        ...(param !== undefined ? { param } : {}),
-      });
-    };
-    const isLocal = (b: BlockSpec): boolean =>
-      opts.ignorePlacement === true || b.worker === rt.worker;
-    const ghosts = new Map<string, Ghost>();
-    if (opts.plan) {
-      for (const p of opts.plan.blocks) {
-        ghosts.set(p.name, {
-          name: p.name,
-          type: p.type,
-          worker: p.worker,
-          desiredRate: p.desiredRate,
-          isTimer: p.isTimer,
-          outputs: new Map(p.outputs.map((o) => [o.name, o.shape])),
-          metas: ghostMetas(p),
-        });
-      }
-    }
-    const order = topoOrder(opts.spec);
     // Blocks on other workers are instantiated here only for planning (when no plan was given).
     const planning: Node[] = [];
     const planningByName = new Map<string, Node>();
@@ -508,71 +574,74 @@ export class Runtime {
     // reported (issue 17, defect 5).
     const failed = new Set<string>();
     for (const b of order) {
-      const local = isLocal(b);
+      const local = opts.ignorePlacement === true || b.worker === this.worker;
       if (!local && opts.plan) continue;
       const afterFailure = b.inputs.some((inp) => failed.has(inp.block));
-      const inputs: InputInfo[] = b.inputs.map((inp, index) => {
-        const src = rt.byName.get(inp.block) ?? planningByName.get(inp.block);
-        const ghost = ghosts.get(inp.block);
-        const srcPort = src?.ports.find((p) => p.name === inp.port);
-        const shape = src ? (srcPort?.shape ?? null) : (ghost?.outputs.get(inp.port) ?? null);
-        const meta = src ? srcPort?.meta : ghost?.metas.get(inp.port);
-        return {
-          index,
-          source: inp.source,
-          block: inp.block,
-          port: inp.port,
-          ...((src?.def.type ?? ghost?.type) !== undefined
-            ? { type: src?.def.type ?? ghost?.type }
-            : {}),
-          shape,
-          rate: src ? src.desiredRate : (ghost?.desiredRate ?? 0),
-          isTimer: src ? src.def.timer === true : (ghost?.isTimer ?? false),
-          subscribed: inp.subscribed,
-          ...(meta !== undefined ? { meta } : {}),
-        };
-      });
-      let desired = b.desiredRate ?? 0;
-      if (b.desiredRate === undefined) {
-        const timerIn = inputs.find((i) => i.isTimer && i.rate > 0);
-        const anyIn = inputs.find((i) => i.rate > 0);
-        desired = (timerIn ?? anyIn)?.rate ?? 0;
-      }
-      const node = new Node(rt, b, b.def, desired, local);
-      const ctx = rt.makeContext(node, inputs);
+      const inputs = this.inputInfos(b, planningByName, ghosts);
+      const node = new Node(this, b, b.def, desiredRateOf(b, inputs), local);
+      const ctx = this.makeContext(node, inputs);
       try {
         node.instance = await b.def.create(ctx, b.params);
       } catch (e) {
         failed.add(b.name);
-        if (afterFailure) continue;
-        const param = e instanceof BlockConfigError ? e.param : undefined;
-        const pos =
-          param !== undefined ? (b.paramPos[param.split(/[.[]/)[0]!] ?? b.paramsPos) : b.pos;
-        diag(b, pos, errorMessage(e), param);
+        if (!afterFailure) diagnostics.push(createFailure(file, b, e));
         continue;
       }
       node.status.desiredRate = node.desiredRate;
       for (const out of b.outputs) {
         if (!node.ports.some((p) => p.name === out)) {
-          diag(b, b.pos, `internal error: the block did not declare its output '${out}'`);
+          const message = `internal error: the block did not declare its output '${out}'`;
+          diagnostics.push(blockDiagnostic(file, b, b.pos, message));
         }
       }
       if (local) {
-        rt.nodes.push(node);
-        rt.byName.set(b.name, node);
+        this.nodes.push(node);
+        this.byName.set(b.name, node);
       } else {
         planning.push(node);
         planningByName.set(b.name, node);
       }
     }
-    if (diagnostics.length > 0) {
-      for (const n of [...rt.nodes, ...planning]) rt.safeDispose(n);
-      return { runtime: undefined, diagnostics, plan: undefined };
-    }
-    // The plan, for workers that did not see the other blocks.
-    const plan: Plan = opts.plan ?? {
+    return { diagnostics, planning, planningByName };
+  }
+
+  /**
+   * What block `b` learns of its inputs: each source's type, shape, rate and meta, from the block
+   * itself when it was created here (for this worker or for planning), else from the plan.
+   */
+  private inputInfos(
+    b: BlockSpec,
+    planningByName: Map<string, Node>,
+    ghosts: Map<string, Ghost>,
+  ): InputInfo[] {
+    return b.inputs.map((inp, index) => {
+      const src = this.byName.get(inp.block) ?? planningByName.get(inp.block);
+      const ghost = ghosts.get(inp.block);
+      const srcPort = src?.ports.find((p) => p.name === inp.port);
+      const shape = src ? (srcPort?.shape ?? null) : (ghost?.outputs.get(inp.port) ?? null);
+      const meta = src ? srcPort?.meta : ghost?.metas.get(inp.port);
+      return {
+        index,
+        source: inp.source,
+        block: inp.block,
+        port: inp.port,
+        ...((src?.def.type ?? ghost?.type) !== undefined
+          ? { type: src?.def.type ?? ghost?.type }
+          : {}),
+        shape,
+        rate: src ? src.desiredRate : (ghost?.desiredRate ?? 0),
+        isTimer: src ? src.def.timer === true : (ghost?.isTimer ?? false),
+        subscribed: inp.subscribed,
+        ...(meta !== undefined ? { meta } : {}),
+      };
+    });
+  }
+
+  /** The plan of every block in `order` (all created, here or for planning: no plan was given). */
+  private planOf(order: BlockSpec[], planningByName: Map<string, Node>): Plan {
+    return {
       blocks: order.map((b) => {
-        const n = rt.byName.get(b.name) ?? planningByName.get(b.name)!;
+        const n = this.byName.get(b.name) ?? planningByName.get(b.name)!;
         return {
           name: b.name,
           type: b.type,
@@ -590,35 +659,24 @@ export class Runtime {
         };
       }),
     };
-    for (const n of planning) rt.safeDispose(n);
-    if (!opts.plan) {
-      // Blocks placed on other workers are known from here on through the plan, like elsewhere.
-      for (const p of plan.blocks) {
-        if (rt.byName.has(p.name)) continue;
-        ghosts.set(p.name, {
-          name: p.name,
-          type: p.type,
-          worker: p.worker,
-          desiredRate: p.desiredRate,
-          isTimer: p.isTimer,
-          outputs: new Map(p.outputs.map((o) => [o.name, o.shape])),
-          metas: ghostMetas(p),
-        });
-      }
-    }
+  }
 
-    // Edges (in file order of consumers, so delivery order is stable).
-    for (const b of opts.spec.blocks) {
-      const to = rt.byName.get(b.name);
+  /**
+   * Creates the edges into this worker's blocks, in file order of consumers (so delivery order is
+   * stable); a source on another worker is known by its ghost (the ring is attached later).
+   */
+  private connectEdges(ghosts: Map<string, Ghost>): void {
+    for (const b of this.spec.blocks) {
+      const to = this.byName.get(b.name);
       if (!to) continue;
       b.inputs.forEach((inp, index) => {
-        const from = rt.byName.get(inp.block);
+        const from = this.byName.get(inp.block);
         const fromPort = from?.ports.find((p) => p.name === inp.port) ?? null;
         const srcShape = fromPort?.shape ?? ghosts.get(inp.block)?.outputs.get(inp.port);
         const srcRate = from?.desiredRate ?? ghosts.get(inp.block)?.desiredRate ?? 0;
         const cap = b.queue.capacity ?? Math.max(DEFAULT_QUEUE_MIN, Math.ceil(srcRate));
         const e = new Edge(
-          rt.edges.length,
+          this.edges.length,
           inp.block,
           fromPort,
           inp.port,
@@ -630,22 +688,23 @@ export class Runtime {
         );
         e.srcShape = srcShape ?? null;
         if (srcShape && b.queue.policy === "latest") e.one = new Frame(srcShape, 1);
-        rt.edges.push(e);
+        this.edges.push(e);
         to.inEdges.push(e);
         fromPort?.edges.push(e);
       });
     }
-    // Path logs
-    if (rt.logs) {
-      for (const n of rt.nodes) {
-        if (n.spec.path === undefined) continue;
-        n.ports.forEach((p, i) => {
-          p.log = rt.logs!.open(n.name, p.name, i === 0, n.spec.path!, p.shape);
-        });
-      }
+  }
+
+  /** Opens the path logs: one per output of every block with a `Path` (none without a log sink). */
+  private openPathLogs(): void {
+    const logs = this.logs;
+    if (!logs) return;
+    for (const n of this.nodes) {
+      if (n.spec.path === undefined) continue;
+      n.ports.forEach((p, i) => {
+        p.log = logs.open(n.name, p.name, i === 0, n.spec.path!, p.shape);
+      });
     }
-    for (const n of rt.nodes) if (n.finite) rt.finiteCount++;
-    return { runtime: rt, diagnostics, plan };
   }
 
   private safeDispose(n: Node): void {
@@ -656,9 +715,9 @@ export class Runtime {
     }
   }
 
+  /** The context `node`'s block is created with (its window on the runtime), see `BlockContext`. */
   private makeContext(node: Node, inputs: InputInfo[]): BlockContext {
     const rt = this;
-    const sched = this.scheduler;
     return {
       name: node.name,
       type: node.spec.type,
@@ -678,70 +737,12 @@ export class Runtime {
       virtual: this.virtual,
       resources: this.resources,
       io: this.io,
-      output(shape: Shape, port?: string, meta?: PortMeta): OutputPort {
-        const name = port ?? node.spec.outputs[node.ports.length] ?? "out";
-        if (node.ports.some((p) => p.name === name)) {
-          throw new Error(`output '${name}' declared twice`);
-        }
-        if (!(
-          shape.rows >= 1 &&
-          shape.cols >= 0 &&
-          Number.isInteger(shape.rows) &&
-          Number.isInteger(shape.cols)
-        )) {
-          throw new Error(`invalid output shape ${formatShape(shape)}`);
-        }
-        const p = new OutPort(node, name, shape);
-        p.meta = meta ?? inheritedMeta(inputs, shape);
-        const problem = p.meta && portMetaProblem(p.meta, shape.rows * shape.cols);
-        if (problem) throw new Error(`output '${name}': ${problem}`);
-        node.ports.push(p);
-        return p;
-      },
+      output: (shape, port, meta) => rt.declareOutput(node, inputs, shape, port, meta),
       get batching() {
         return node.batchS;
       },
-      every(hz: number, tick: TickCallback, options?: { catchUp?: CatchUp }): TimerHandle {
-        if (!(hz > 0)) throw new BlockConfigError(`a timer rate must be positive, got ${hz}`);
-        const e = sched.addPeriodic(node.name, hz, tick, {
-          batchS: node.batchS,
-          ...(options?.catchUp !== undefined ? { catchUp: options.catchUp } : {}),
-        });
-        node.timers.push(e);
-        return {
-          start() {
-            if (!e.running) {
-              sched.start(e, rt.clock.now());
-              rt.onWake?.();
-            }
-          },
-          stop() {
-            sched.stop(e);
-          },
-          get running() {
-            return e.running;
-          },
-          get fired() {
-            return e.fired;
-          },
-          get missed() {
-            return e.missed;
-          },
-          setRate(h: number) {
-            if (!(h > 0)) throw new Error(`a timer rate must be positive, got ${h}`);
-            sched.setRate(e, h, rt.clock.now());
-            rt.onWake?.();
-          },
-        };
-      },
-      at(t: number, fn: (t: number) => void, latest?: number) {
-        if (!node.oneShot) {
-          node.oneShot = sched.addOneShot(node.name, fn);
-        }
-        node.oneShot.cb = fn;
-        sched.once(node.oneShot, t, latest);
-        rt.onWake?.();
-      },
+      every: (hz, tick, options) => rt.addTimer(node, hz, tick, options),
+      at: (t, fn, latest) => rt.scheduleAt(node, t, fn, latest),
       setText(text: string) {
         node.text = text;
       },
@@ -757,28 +758,121 @@ export class Runtime {
       reportCompute(ms: number, budgetMs?: number) {
         node.status.external(ms, rt.clock.now(), budgetMs);
       },
-      setSubscribed(index: number, subscribed: boolean): boolean {
-        const e = node.inEdges.find((x) => x.toIndex === index);
-        if (!e) return false;
-        if (e.subscribed !== subscribed) {
-          e.subscribed = subscribed;
-          if (!subscribed) rt.dropPending(e);
+      setSubscribed: (index, subscribed) => rt.subscribeInput(node, index, subscribed),
+      openLog: (path, stream, shape) => rt.openExtraLog(node, path, stream, shape),
+      finish: () => rt.finishNode(node),
+    };
+  }
+
+  /**
+   * `ctx.output`: declares output `port` of `node` (by default its next name in the spec, else
+   * "out"), with `meta` or, without, the meta it inherits from its inputs.
+   */
+  private declareOutput(
+    node: Node,
+    inputs: InputInfo[],
+    shape: Shape,
+    port?: string,
+    meta?: PortMeta,
+  ): OutPort {
+    const name = port ?? node.spec.outputs[node.ports.length] ?? "out";
+    if (node.ports.some((p) => p.name === name)) {
+      throw new Error(`output '${name}' declared twice`);
+    }
+    if (!(
+      shape.rows >= 1 &&
+      shape.cols >= 0 &&
+      Number.isInteger(shape.rows) &&
+      Number.isInteger(shape.cols)
+    )) {
+      throw new Error(`invalid output shape ${formatShape(shape)}`);
+    }
+    const p = new OutPort(node, name, shape);
+    p.meta = meta ?? inheritedMeta(inputs, shape);
+    const problem = p.meta && portMetaProblem(p.meta, shape.rows * shape.cols);
+    if (problem) throw new Error(`output '${name}': ${problem}`);
+    node.ports.push(p);
+    return p;
+  }
+
+  /** `ctx.every`: registers a periodic timer of `node` (idle until its handle's `start`). */
+  private addTimer(
+    node: Node,
+    hz: number,
+    tick: TickCallback,
+    options?: { catchUp?: CatchUp },
+  ): TimerHandle {
+    const rt = this;
+    const sched = this.scheduler;
+    if (!(hz > 0)) throw new BlockConfigError(`a timer rate must be positive, got ${hz}`);
+    const e = sched.addPeriodic(node.name, hz, tick, {
+      batchS: node.batchS,
+      ...(options?.catchUp !== undefined ? { catchUp: options.catchUp } : {}),
+    });
+    node.timers.push(e);
+    return {
+      start() {
+        if (!e.running) {
+          sched.start(e, rt.clock.now());
+          rt.onWake?.();
         }
-        return true;
       },
-      openLog(path: string, stream: string, shape: Shape): LogChannel | null {
-        if (!rt.logs) return null;
-        const ch = rt.logs.open(stream, "out", true, path, shape);
-        node.extraLogs.push(ch);
-        return ch;
+      stop() {
+        sched.stop(e);
       },
-      finish() {
-        if (!node.finished) {
-          node.finished = true;
-          if (node.finite) rt.finishedCount++;
-        }
+      get running() {
+        return e.running;
+      },
+      get fired() {
+        return e.fired;
+      },
+      get missed() {
+        return e.missed;
+      },
+      setRate(h: number) {
+        if (!(h > 0)) throw new Error(`a timer rate must be positive, got ${h}`);
+        sched.setRate(e, h, rt.clock.now());
+        rt.onWake?.();
       },
     };
+  }
+
+  /** `ctx.at`: (re)arms `node`'s one-shot timer (one per block) for `t`, with callback `fn`. */
+  private scheduleAt(node: Node, t: number, fn: (t: number) => void, latest?: number): void {
+    const sched = this.scheduler;
+    if (!node.oneShot) {
+      node.oneShot = sched.addOneShot(node.name, fn);
+    }
+    node.oneShot.cb = fn;
+    sched.once(node.oneShot, t, latest);
+    this.onWake?.();
+  }
+
+  /** `ctx.setSubscribed`: (un)subscribes `node`'s input `index`; false when it has none. */
+  private subscribeInput(node: Node, index: number, subscribed: boolean): boolean {
+    const e = node.inEdges.find((x) => x.toIndex === index);
+    if (!e) return false;
+    if (e.subscribed !== subscribed) {
+      e.subscribed = subscribed;
+      if (!subscribed) this.dropPending(e);
+    }
+    return true;
+  }
+
+  /** `ctx.openLog`: opens an extra log of `node` (closed on dispose); null without a log sink. */
+  private openExtraLog(node: Node, path: string, stream: string, shape: Shape): LogChannel | null {
+    if (!this.logs) return null;
+    const ch = this.logs.open(stream, "out", true, path, shape);
+    node.extraLogs.push(ch);
+    return ch;
+  }
+
+  /** `ctx.finish`: marks `node` finished (counted once, if it is a finite source). */
+  private finishNode(node: Node): void {
+    if (!node.finished) {
+      node.finished = true;
+      if (node.finite) this.finishedCount++;
+    }
   }
 
   // -------------------------------------------------------------------------------------------
