@@ -167,6 +167,7 @@ async function cmdFormat(args: string[]): Promise<number> {
   }
   // The same full check as `mosaic validate` (loader, then every block instantiated).
   const { loadDspFromDisk, validatePipelineFile } = await import("../host/validate");
+  const { PipelineDocument } = await import("../engine/pipeline/document");
   loadDspFromDisk();
   let invalid = false;
   let changed = 0;
@@ -183,7 +184,7 @@ async function cmdFormat(args: string[]): Promise<number> {
     let formatted: string;
     try {
       source = readFileSync(f, "utf8");
-      const doc = (await import("../engine/pipeline/document")).PipelineDocument.parse(source, f);
+      const doc = PipelineDocument.parse(source, f);
       doc.normalize();
       formatted = doc.toString();
     } catch (e) {
