@@ -119,6 +119,108 @@ describe("menu template", () => {
     walk(t);
   });
 
+  test("the whole template, item by item: order, ids, labels, accelerators, roles, clicks", () => {
+    const { a, calls } = actions();
+    /** One line per item, its keys in order; `click` shows the action it calls. */
+    const outline = (items: MenuItemConstructorOptions[], indent = ""): string[] =>
+      items.flatMap((item) => {
+        const fields = Object.entries(item).flatMap(([k, v]) => {
+          if (k === "submenu") return [];
+          if (k !== "click") return [`${k}=${String(v)}`];
+          calls.length = 0;
+          (v as () => void)();
+          return [`click->${calls.join(",")}`];
+        });
+        const sub = Array.isArray(item.submenu) ? outline(item.submenu, `${indent}  `) : [];
+        return [indent + fields.join(" "), ...sub];
+      });
+
+    const linux = buildMenuTemplate(
+      { recent: ["/p/a.yaml", "/q/R&D/b.yaml"], canSave: true, dev: true, platform: "linux" },
+      a,
+    );
+    expect(outline(linux)).toEqual([
+      "id=file label=&File",
+      "  id=open label=&Open Pipeline… accelerator=CmdOrCtrl+O click->open",
+      "  id=recent label=Open &Recent",
+      "    id=recent-0 label=a.yaml — /p toolTip=/p/a.yaml click->recent:/p/a.yaml",
+      "    id=recent-1 label=b.yaml — /q/R&&D toolTip=/q/R&D/b.yaml click->recent:/q/R&D/b.yaml",
+      "    type=separator",
+      "    id=recent-clear label=Clear Recently Opened enabled=true click->clear",
+      "  type=separator",
+      "  id=save-as label=&Save Pipeline As… accelerator=CmdOrCtrl+Shift+S enabled=true click->save",
+      "  type=separator",
+      "  id=quit label=Quit accelerator=CmdOrCtrl+Q click->quit",
+      "id=edit label=&Edit",
+      "  role=undo",
+      "  role=redo",
+      "  type=separator",
+      "  role=cut",
+      "  role=copy",
+      "  role=paste",
+      "  role=selectAll",
+      "id=view label=&View",
+      "  id=reload label=&Reload accelerator=CmdOrCtrl+R click->reload",
+      "  id=devtools label=Toggle &Developer Tools accelerator=Ctrl+Shift+I click->devtools",
+      "  type=separator",
+      "  role=resetZoom",
+      "  role=zoomIn",
+      "  role=zoomOut",
+      "  type=separator",
+      "  role=togglefullscreen",
+      "id=help label=&Help role=help",
+      "  id=about label=About MOSAIC click->about",
+    ]);
+
+    const mac = buildMenuTemplate(
+      { recent: [], canSave: false, dev: true, platform: "darwin", appName: "Mosaic Dev" },
+      a,
+    );
+    expect(outline(mac)).toEqual([
+      "id=app label=Mosaic Dev",
+      "  id=about label=About Mosaic Dev click->about",
+      "  type=separator",
+      "  role=services",
+      "  type=separator",
+      "  role=hide",
+      "  role=hideOthers",
+      "  role=unhide",
+      "  type=separator",
+      "  id=quit label=Quit Mosaic Dev accelerator=CmdOrCtrl+Q click->quit",
+      "id=file label=&File",
+      "  id=open label=&Open Pipeline… accelerator=CmdOrCtrl+O click->open",
+      "  id=recent label=Open &Recent",
+      "    id=recent-none label=No recent pipelines enabled=false",
+      "    type=separator",
+      "    id=recent-clear label=Clear Recently Opened enabled=false click->clear",
+      "  type=separator",
+      "  id=save-as label=&Save Pipeline As… accelerator=CmdOrCtrl+Shift+S enabled=false click->save",
+      "  type=separator",
+      "  role=close",
+      "id=edit label=&Edit",
+      "  role=undo",
+      "  role=redo",
+      "  type=separator",
+      "  role=cut",
+      "  role=copy",
+      "  role=paste",
+      "  role=selectAll",
+      "id=view label=&View",
+      "  id=reload label=&Reload accelerator=CmdOrCtrl+R click->reload",
+      "  id=devtools label=Toggle &Developer Tools accelerator=Alt+Command+I click->devtools",
+      "  type=separator",
+      "  role=resetZoom",
+      "  role=zoomIn",
+      "  role=zoomOut",
+      "  type=separator",
+      "  role=togglefullscreen",
+      "id=help label=&Help role=help",
+      "  id=about label=About Mosaic Dev click->about",
+    ]);
+    // macOS shares one About item between the application menu and Help.
+    expect(findMenuItem(mac.slice(-1), "about")).toBe(findMenuItem(mac, "about"));
+  });
+
   test("recent labels escape mnemonics", () => {
     expect(recentLabel("/data/R&D/emg.yaml")).toBe("emg.yaml — /data/R&&D");
   });
