@@ -1280,68 +1280,8 @@ export class Runtime {
    */
   telemetry(at?: number): Telemetry {
     const now = at ?? this.clock.now();
-    const blocks: BlockTelemetry[] = this.nodes.map((n) => {
-      const s = n.status;
-      const ev = s.evaluate(now);
-      let dropsIn = 0;
-      for (const e of n.inEdges) dropsIn += e.dropped;
-      const timer = n.def.timer ? n.timers[0] : undefined;
-      const bt: BlockTelemetry = {
-        name: n.name,
-        type: n.spec.type,
-        worker: this.worker,
-        status: ev.status,
-        lagging: ev.lagging,
-        stumbling: ev.stumbling,
-        rate: Number.isFinite(ev.rate) ? hz(ev.rate) : 0,
-        desiredRate: n.desiredRate,
-        events: s.events,
-        computeLastMs: ms(s.computeLast),
-        computeMeanMs: s.callsWindow ? ms(s.computeSumWindow / s.callsWindow) : 0,
-        computeMaxMs: ms(s.computeMaxWindow),
-        latencyMs: s.latencyN ? ms((s.latencySum / s.latencyN) * 1000) : 0,
-        delay: delayFigures(s),
-        dropsIn,
-        text: n.text,
-        errors: n.errors,
-        lastError: n.lastError,
-        finished: n.finished,
-        timing: {
-          n: s.dtN,
-          meanDt: seconds(s.dtMean),
-          stdDt: seconds(s.dtStd()),
-          computeTotalMs: ms(s.computeTotal),
-          calls: s.calls,
-        },
-      };
-      if (timer) {
-        const h = timer.lateness;
-        bt.timer = {
-          fired: timer.fired,
-          missed: timer.missed,
-          catchUp: timer.catchUp,
-          batchingMs: timer.batchS * 1000,
-          latenessP50Us: h ? h.quantile(0.5) : 0,
-          latenessP99Us: h ? h.quantile(0.99) : 0,
-          latenessMaxUs: h && h.count ? Math.round(h.maxUs * 10) / 10 : 0,
-          running: timer.running,
-        };
-      }
-      s.resetWindow();
-      return bt;
-    });
-    const edges: EdgeTelemetry[] = this.edges.map((e) => ({
-      id: e.id,
-      from: e.fromName,
-      fromPort: e.fromPortName,
-      to: e.to.name,
-      toIndex: e.toIndex,
-      subscribed: e.subscribed,
-      rate: hz(e.rate()),
-      delivered: e.delivered,
-      dropped: e.dropped,
-      pending: e.pendingEvents,
-    }));
+    const blocks = this.nodes.map((n) => blockTelemetry(n, this.worker, now));
+    const edges = this.edges.map(edgeTelemetry);
     const events = this.events.splice(0, this.events.length);
     return { t: now, worker: this.worker, blocks, edges, events, finished: this.finished };
   }
@@ -1352,6 +1292,81 @@ export function batchingOf(spec: PipelineSpec): number {
   return spec.settings.batchingMs !== undefined
     ? spec.settings.batchingMs / 1000
     : DEFAULT_BATCHING_S;
+}
+
+/** One block's telemetry at clock time `now`; starts the block's next telemetry window. */
+function blockTelemetry(n: Node, worker: string, now: number): BlockTelemetry {
+  const s = n.status;
+  const ev = s.evaluate(now);
+  let dropsIn = 0;
+  for (const e of n.inEdges) dropsIn += e.dropped;
+  const bt: BlockTelemetry = {
+    name: n.name,
+    type: n.spec.type,
+    worker,
+    status: ev.status,
+    lagging: ev.lagging,
+    stumbling: ev.stumbling,
+    rate: Number.isFinite(ev.rate) ? hz(ev.rate) : 0,
+    desiredRate: n.desiredRate,
+    events: s.events,
+    computeLastMs: ms(s.computeLast),
+    computeMeanMs: s.callsWindow ? ms(s.computeSumWindow / s.callsWindow) : 0,
+    computeMaxMs: ms(s.computeMaxWindow),
+    latencyMs: s.latencyN ? ms((s.latencySum / s.latencyN) * 1000) : 0,
+    delay: delayFigures(s),
+    dropsIn,
+    text: n.text,
+    errors: n.errors,
+    lastError: n.lastError,
+    finished: n.finished,
+    timing: timingFigures(s),
+  };
+  const timer = n.def.timer ? n.timers[0] : undefined;
+  if (timer) bt.timer = timerFigures(timer);
+  s.resetWindow();
+  return bt;
+}
+
+/** ΔT statistics and compute totals since the start or the last timing reset (Table 5). */
+function timingFigures(s: StatusTracker): BlockTelemetry["timing"] {
+  return {
+    n: s.dtN,
+    meanDt: seconds(s.dtMean),
+    stdDt: seconds(s.dtStd()),
+    computeTotalMs: ms(s.computeTotal),
+    calls: s.calls,
+  };
+}
+
+/** A timer block's counters and lateness (fire − deadline) figures. */
+function timerFigures(timer: TimerEntry): NonNullable<BlockTelemetry["timer"]> {
+  const h = timer.lateness;
+  return {
+    fired: timer.fired,
+    missed: timer.missed,
+    catchUp: timer.catchUp,
+    batchingMs: timer.batchS * 1000,
+    latenessP50Us: h ? h.quantile(0.5) : 0,
+    latenessP99Us: h ? h.quantile(0.99) : 0,
+    latenessMaxUs: h && h.count ? Math.round(h.maxUs * 10) / 10 : 0,
+    running: timer.running,
+  };
+}
+
+function edgeTelemetry(e: Edge): EdgeTelemetry {
+  return {
+    id: e.id,
+    from: e.fromName,
+    fromPort: e.fromPortName,
+    to: e.to.name,
+    toIndex: e.toIndex,
+    subscribed: e.subscribed,
+    rate: hz(e.rate()),
+    delivered: e.delivered,
+    dropped: e.dropped,
+    pending: e.pendingEvents,
+  };
 }
 
 function delayFigures(s: StatusTracker): BlockTelemetry["delay"] {
