@@ -473,6 +473,7 @@ export class MyoRun {
     this.emgSamples = 0;
     this.imuSamples = 0;
     this.malformed = 0;
+    this.lastMalformed = "";
     this.dropped = 0;
     this.disconnections = 0;
     this.refresh();
