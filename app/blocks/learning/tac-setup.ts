@@ -62,6 +62,12 @@ export function tacPorts(
       "Targets",
     );
   }
+  if (stimulus !== undefined && targets !== undefined) {
+    throw new BlockConfigError(
+      `give Targets or Stimulus, not both (the trials are the captures of Stimulus '${stimulus}')`,
+      "Targets",
+    );
+  }
   if (targetIn === null && targets === undefined && stimulus === undefined) {
     throw new BlockConfigError(
       "give Targets (a list of target vectors or { Random: { Count } }) or a second input with targets",

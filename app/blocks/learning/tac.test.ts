@@ -260,6 +260,10 @@ describe("TAC", () => {
     await expect(tac({ Targets: [[1, 0]] }, 2)).rejects.toThrow(
       "give Targets or a target input, not both",
     );
+    // With Stimulus, its captures are the trials: a list of Targets would be ignored.
+    await expect(tac({ Targets: [[1, 0]], Stimulus: "Cues" })).rejects.toThrow(
+      "give Targets or Stimulus, not both (the trials are the captures of Stimulus 'Cues')",
+    );
     await expect(tac({ Targets: [[1, 0, 0]] })).rejects.toThrow(
       "Targets[0] has 3 values, but the control input 'in0' has 2 DoFs",
     );

@@ -88,7 +88,8 @@ const params = z.strictObject({
     .describe(
       "MOSAIC's form: the Stimulus whose capture phases are the trials, read by name (on the " +
         "same worker): a trial starts with a capture and ends with it, and a success ends the " +
-        "capture (the Stimulus moves on to fall); the target input then only feeds displays",
+        "capture (the Stimulus moves on to fall); the target input then only feeds displays " +
+        "(not with Targets)",
     ),
 });
 
