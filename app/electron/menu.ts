@@ -46,111 +46,42 @@ export function buildMenuTemplate(
 ): MenuItemConstructorOptions[] {
   const mac = state.platform === "darwin";
   const appName = state.appName ?? "MOSAIC";
-  const about: MenuItemConstructorOptions = {
+  // One About and one Quit item: macOS shows them in the application menu too.
+  const about = aboutItem(appName, actions);
+  const quit = quitItem(mac, appName, actions);
+  const menus = [
+    fileMenu(state, actions, mac, quit),
+    editMenu(),
+    viewMenu(state, actions, mac),
+    helpMenu(about),
+  ];
+  return mac ? [appMenu(appName, about, quit), ...menus] : menus;
+}
+
+function aboutItem(appName: string, actions: MenuActions): MenuItemConstructorOptions {
+  return {
     id: "about",
     label: `About ${appName}`,
     click: () => actions.about(),
   };
-  const quit: MenuItemConstructorOptions = {
+}
+
+function quitItem(mac: boolean, appName: string, actions: MenuActions): MenuItemConstructorOptions {
+  return {
     id: "quit",
     label: mac ? `Quit ${appName}` : "Quit",
     accelerator: "CmdOrCtrl+Q",
     click: () => actions.quit(),
   };
+}
 
-  const recentItems: MenuItemConstructorOptions[] =
-    state.recent.length === 0
-      ? [{ id: "recent-none", label: "No recent pipelines", enabled: false }]
-      : state.recent.map((file, i) => ({
-          id: `recent-${i}`,
-          label: recentLabel(file),
-          toolTip: file,
-          click: () => actions.openRecent(file),
-        }));
-
-  const file: MenuItemConstructorOptions = {
-    id: "file",
-    label: "&File",
-    submenu: [
-      {
-        id: "open",
-        label: "&Open Pipeline…",
-        accelerator: "CmdOrCtrl+O",
-        click: () => actions.openPipeline(),
-      },
-      {
-        id: "recent",
-        label: "Open &Recent",
-        submenu: [
-          ...recentItems,
-          sep,
-          {
-            id: "recent-clear",
-            label: "Clear Recently Opened",
-            enabled: state.recent.length > 0,
-            click: () => actions.clearRecent(),
-          },
-        ],
-      },
-      sep,
-      {
-        id: "save-as",
-        label: "&Save Pipeline As…",
-        accelerator: "CmdOrCtrl+Shift+S",
-        enabled: state.canSave,
-        click: () => actions.savePipelineAs(),
-      },
-      ...(mac ? [sep, { role: "close" } as MenuItemConstructorOptions] : [sep, quit]),
-    ],
-  };
-
-  // Text fields (params forms) need the edit roles for copy and paste on macOS.
-  const edit: MenuItemConstructorOptions = {
-    id: "edit",
-    label: "&Edit",
-    submenu: [
-      { role: "undo" },
-      { role: "redo" },
-      sep,
-      { role: "cut" },
-      { role: "copy" },
-      { role: "paste" },
-      { role: "selectAll" },
-    ],
-  };
-
-  const view: MenuItemConstructorOptions = {
-    id: "view",
-    label: "&View",
-    submenu: [
-      { id: "reload", label: "&Reload", accelerator: "CmdOrCtrl+R", click: () => actions.reload() },
-      ...(state.dev
-        ? [
-            {
-              id: "devtools",
-              label: "Toggle &Developer Tools",
-              accelerator: mac ? "Alt+Command+I" : "Ctrl+Shift+I",
-              click: () => actions.toggleDevTools(),
-            },
-          ]
-        : []),
-      sep,
-      { role: "resetZoom" },
-      { role: "zoomIn" },
-      { role: "zoomOut" },
-      sep,
-      { role: "togglefullscreen" },
-    ],
-  };
-
-  const help: MenuItemConstructorOptions = {
-    id: "help",
-    label: "&Help",
-    role: "help",
-    submenu: [about],
-  };
-
-  const appMenu: MenuItemConstructorOptions = {
+/** macOS only: the application menu, named after the app. */
+function appMenu(
+  appName: string,
+  about: MenuItemConstructorOptions,
+  quit: MenuItemConstructorOptions,
+): MenuItemConstructorOptions {
+  return {
     id: "app",
     label: appName,
     submenu: [
@@ -165,8 +96,126 @@ export function buildMenuTemplate(
       quit,
     ],
   };
+}
 
-  return mac ? [appMenu, file, edit, view, help] : [file, edit, view, help];
+/** Open, Open Recent, Save As, then Close Window (macOS) or Quit. */
+function fileMenu(
+  state: MenuState,
+  actions: MenuActions,
+  mac: boolean,
+  quit: MenuItemConstructorOptions,
+): MenuItemConstructorOptions {
+  return {
+    id: "file",
+    label: "&File",
+    submenu: [
+      {
+        id: "open",
+        label: "&Open Pipeline…",
+        accelerator: "CmdOrCtrl+O",
+        click: () => actions.openPipeline(),
+      },
+      recentMenu(state.recent, actions),
+      sep,
+      {
+        id: "save-as",
+        label: "&Save Pipeline As…",
+        accelerator: "CmdOrCtrl+Shift+S",
+        enabled: state.canSave,
+        click: () => actions.savePipelineAs(),
+      },
+      ...(mac ? [sep, { role: "close" } as MenuItemConstructorOptions] : [sep, quit]),
+    ],
+  };
+}
+
+/** File → Open Recent: the files newest first (or a disabled "none"), then Clear. */
+function recentMenu(recent: readonly string[], actions: MenuActions): MenuItemConstructorOptions {
+  return {
+    id: "recent",
+    label: "Open &Recent",
+    submenu: [
+      ...recentItems(recent, actions),
+      sep,
+      {
+        id: "recent-clear",
+        label: "Clear Recently Opened",
+        enabled: recent.length > 0,
+        click: () => actions.clearRecent(),
+      },
+    ],
+  };
+}
+
+function recentItems(
+  recent: readonly string[],
+  actions: MenuActions,
+): MenuItemConstructorOptions[] {
+  if (recent.length === 0)
+    return [{ id: "recent-none", label: "No recent pipelines", enabled: false }];
+  return recent.map((file, i) => ({
+    id: `recent-${i}`,
+    label: recentLabel(file),
+    toolTip: file,
+    click: () => actions.openRecent(file),
+  }));
+}
+
+/** Text fields (params forms) need the edit roles for copy and paste on macOS. */
+function editMenu(): MenuItemConstructorOptions {
+  return {
+    id: "edit",
+    label: "&Edit",
+    submenu: [
+      { role: "undo" },
+      { role: "redo" },
+      sep,
+      { role: "cut" },
+      { role: "copy" },
+      { role: "paste" },
+      { role: "selectAll" },
+    ],
+  };
+}
+
+/** Reload, Toggle Developer Tools (development builds), zoom and full screen. */
+function viewMenu(
+  state: MenuState,
+  actions: MenuActions,
+  mac: boolean,
+): MenuItemConstructorOptions {
+  return {
+    id: "view",
+    label: "&View",
+    submenu: [
+      { id: "reload", label: "&Reload", accelerator: "CmdOrCtrl+R", click: () => actions.reload() },
+      ...(state.dev ? [devToolsItem(mac, actions)] : []),
+      sep,
+      { role: "resetZoom" },
+      { role: "zoomIn" },
+      { role: "zoomOut" },
+      sep,
+      { role: "togglefullscreen" },
+    ],
+  };
+}
+
+function devToolsItem(mac: boolean, actions: MenuActions): MenuItemConstructorOptions {
+  return {
+    id: "devtools",
+    label: "Toggle &Developer Tools",
+    accelerator: mac ? "Alt+Command+I" : "Ctrl+Shift+I",
+    click: () => actions.toggleDevTools(),
+  };
+}
+
+function helpMenu(about: MenuItemConstructorOptions): MenuItemConstructorOptions {
+  return {
+    id: "help",
+    label: "&Help",
+    role: "help",
+    submenu: [about],
+  };
 }
 
 /** Finds an item by id anywhere in a template (tests, and the main process for `enabled`). */
