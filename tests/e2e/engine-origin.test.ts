@@ -4,9 +4,8 @@
  * right token names mosaic serve and its address; the browser build, and a serve URL without
  * its token, name the page's own engine.
  */
-import type { ChildProcess } from "node:child_process";
 import { afterAll, beforeAll, describe, expect, test } from "vitest";
-import { requireBuild, startCli } from "../integration/helpers";
+import { requireBuild } from "../integration/helpers";
 import {
   artifact,
   ensureWebBuild,
@@ -14,8 +13,9 @@ import {
   launchChromium,
   openApp,
   serveApp,
-  servedUrl,
+  startCliServer,
   type Chromium,
+  type CliServer,
   type Served,
 } from "./harness";
 
@@ -23,7 +23,7 @@ import {
 const ENGINE_LABEL = `(document.querySelector("header .engine-where")?.textContent ?? "")`;
 
 describe.skipIf(!haveChromium)("the page names its engine and a refusal's cause", () => {
-  let cli: ChildProcess | undefined;
+  let server: CliServer | undefined;
   let url: URL;
   let browser: Chromium;
   let web: Served | undefined;
@@ -31,18 +31,15 @@ describe.skipIf(!haveChromium)("the page names its engine and a refusal's cause"
   beforeAll(async () => {
     ensureWebBuild();
     requireBuild();
-    cli = startCli(["serve", "pipelines/demo.yaml", "--port", "0"]);
-    url = new URL(await servedUrl(cli, 20_000));
+    server = await startCliServer(["serve", "pipelines/demo.yaml", "--port", "0"], 20_000);
+    url = new URL(server.url);
     browser = await launchChromium();
   }, 60_000);
 
   afterAll(async () => {
     await browser?.close();
     await web?.close();
-    if (cli && cli.exitCode === null) {
-      cli.kill("SIGINT");
-      await new Promise((r) => cli!.once("exit", r));
-    }
+    await server?.stop();
   });
 
   test("a wrong token: the page says mosaic serve refused it and why", async () => {

@@ -21,6 +21,7 @@ import { dirname, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
 import { chromium, type BrowserContext, type Page } from "playwright-core";
 import { serveStatic, type WebServer } from "../../app/host/web-server";
+import { startCli } from "../integration/helpers";
 
 export const ROOT = resolve(dirname(fileURLToPath(import.meta.url)), "../..");
 export const WEB = join(ROOT, "dist/web");
@@ -225,4 +226,34 @@ const SERVED_AT = /MOSAIC is at (\S+)/;
  */
 export async function servedUrl(cli: ChildProcess, ms = 30_000): Promise<string> {
   return SERVED_AT.exec(await printedLine(cli, SERVED_AT, ms))![1]!;
+}
+
+export interface CliServer {
+  /** The URL the CLI printed ("MOSAIC is at URL"), token included. */
+  url: string;
+  child: ChildProcess;
+  /** SIGINT, then waits for the exit (nothing when it has already exited). */
+  stop(): Promise<void>;
+}
+
+/**
+ * Starts the built CLI with `args` (`["serve", pipeline, "--port", "0"]`) and waits up to `ms` for
+ * the URL it prints. When it prints none, it is stopped and the error (with what it printed) is
+ * thrown. Stop it with `stop()` in the suite's afterAll.
+ */
+export async function startCliServer(args: string[], ms = 30_000): Promise<CliServer> {
+  const child = startCli(args);
+  const stop = async (): Promise<void> => {
+    // A child killed by a signal has exitCode null and signalCode set: its exit has fired.
+    if (child.exitCode === null && child.signalCode === null) {
+      child.kill("SIGINT");
+      await new Promise((r) => child.once("exit", r));
+    }
+  };
+  try {
+    return { url: await servedUrl(child, ms), child, stop };
+  } catch (e) {
+    await stop();
+    throw e;
+  }
 }

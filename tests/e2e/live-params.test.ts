@@ -5,12 +5,11 @@
  * file" downloads the pipeline's text with the new value and every comment kept, after which the
  * markers clear in both tabs. Save layout says which live values it leaves out.
  */
-import type { ChildProcess } from "node:child_process";
 import { readFileSync } from "node:fs";
 import { join } from "node:path";
 import type { Download, Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, test } from "vitest";
-import { requireBuild, startCli } from "../integration/helpers";
+import { requireBuild } from "../integration/helpers";
 import {
   artifact,
   ensureWebBuild,
@@ -19,9 +18,10 @@ import {
   openApp,
   ROOT,
   serveApp,
-  servedUrl,
+  startCliServer,
   type AppPage,
   type Chromium,
+  type CliServer,
 } from "./harness";
 
 const PANEL = '[data-panel="Amplification"]';
@@ -73,7 +73,7 @@ async function downloadText(page: Page, click: () => Promise<void>): Promise<str
 }
 
 describe.skipIf(!haveChromium)("live params on mosaic serve (two tabs)", () => {
-  let cli: ChildProcess;
+  let server: CliServer | undefined;
   let url: string;
   let browser: Chromium;
   let a: AppPage;
@@ -82,8 +82,8 @@ describe.skipIf(!haveChromium)("live params on mosaic serve (two tabs)", () => {
   beforeAll(async () => {
     ensureWebBuild();
     requireBuild();
-    cli = startCli(["serve", "pipelines/demo.yaml", "--port", "0"]);
-    url = await servedUrl(cli, 30_000);
+    server = await startCliServer(["serve", "pipelines/demo.yaml", "--port", "0"]);
+    url = server.url;
     browser = await launchChromium();
     a = await openApp(browser, url, undefined, { waitRunning: false });
     b = await openApp(browser, url, undefined, { waitRunning: false });
@@ -95,10 +95,7 @@ describe.skipIf(!haveChromium)("live params on mosaic serve (two tabs)", () => {
 
   afterAll(async () => {
     await browser?.close();
-    if (cli && cli.exitCode === null) {
-      cli.kill("SIGINT");
-      await new Promise((r) => cli.once("exit", r));
-    }
+    await server?.stop();
   });
 
   test("a value changed in either tab shows in both, marked; a reload shows the engine's", async () => {

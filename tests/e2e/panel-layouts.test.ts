@@ -7,18 +7,18 @@
  *
  * Needs Chromium (skipped without it).
  */
-import type { ChildProcess } from "node:child_process";
 import { afterAll, beforeAll, describe, expect, test } from "vitest";
 import type { Page } from "playwright-core";
-import { requireBuild, startCli } from "../integration/helpers";
+import { requireBuild } from "../integration/helpers";
 import {
   ensureWebBuild,
   haveChromium,
   launchChromium,
   openApp,
   serveApp,
-  servedUrl,
+  startCliServer,
   type Chromium,
+  type CliServer,
   type Served,
 } from "./harness";
 import type { InPageElement, InPageWindow } from "./in-page";
@@ -172,24 +172,21 @@ describe.skipIf(!haveChromium)("saved panel layouts (Chromium)", () => {
 });
 
 describe.skipIf(!haveChromium)("saved panel layouts with mosaic serve (Chromium)", () => {
-  let cli: ChildProcess;
+  let server: CliServer | undefined;
   let url: string;
   let chromium: Chromium;
 
   beforeAll(async () => {
     ensureWebBuild();
     requireBuild();
-    cli = startCli(["serve", "pipelines/demo.yaml", "--port", "0"]);
-    url = await servedUrl(cli, 30_000);
+    server = await startCliServer(["serve", "pipelines/demo.yaml", "--port", "0"]);
+    url = server.url;
     chromium = await launchChromium();
   }, 90_000);
 
   afterAll(async () => {
     await chromium?.close();
-    if (cli && cli.exitCode === null) {
-      cli.kill("SIGINT");
-      await new Promise((r) => cli.once("exit", r));
-    }
+    await server?.stop();
   });
 
   test("the host's pipeline: the panels come back after a reload of the page", async () => {

@@ -9,10 +9,9 @@
  * engine) and in the browser build (the participant page has no engine: the clinician page's
  * worker drives it through the relay). Screenshots of both windows at 1920×1080.
  */
-import type { ChildProcess } from "node:child_process";
 import type { Page } from "playwright-core";
 import { afterAll, beforeAll, describe, expect, test } from "vitest";
-import { requireBuild, startCli } from "../integration/helpers";
+import { requireBuild } from "../integration/helpers";
 import {
   artifact,
   ensureWebBuild,
@@ -20,9 +19,10 @@ import {
   launchChromium,
   openApp,
   serveApp,
-  servedUrl,
+  startCliServer,
   type AppPage,
   type Chromium,
+  type CliServer,
   type Served,
 } from "./harness";
 
@@ -206,20 +206,17 @@ describe.skipIf(!haveChromium)("participant window", () => {
   });
 
   describe("with mosaic serve", () => {
-    let cli: ChildProcess;
+    let server: CliServer | undefined;
     let url: string;
 
     beforeAll(async () => {
       requireBuild();
-      cli = startCli(["serve", FIXTURE, "--port", "0"]);
-      url = await servedUrl(cli, 30_000);
+      server = await startCliServer(["serve", FIXTURE, "--port", "0"]);
+      url = server.url;
     }, 60_000);
 
     afterAll(async () => {
-      if (cli && cli.exitCode === null) {
-        cli.kill("SIGINT");
-        await new Promise((r) => cli.once("exit", r));
-      }
+      await server?.stop();
     });
 
     test("the participant page follows the clinician's protocol on the host's engine", async () => {

@@ -8,11 +8,11 @@
  * build, the block bundled into one block.js with the guide's esbuild command runs in the page's
  * engine and is in the palette.
  */
-import { spawnSync, type ChildProcess } from "node:child_process";
+import { spawnSync } from "node:child_process";
 import { mkdirSync, readFileSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
 import { afterAll, beforeAll, describe, expect, test } from "vitest";
-import { requireBuild, runCli, startCli, tempDir } from "../integration/helpers";
+import { requireBuild, runCli, tempDir } from "../integration/helpers";
 import {
   artifact,
   ensureWebBuild,
@@ -22,8 +22,9 @@ import {
   ROOT,
   serveApp,
   type Chromium,
+  type CliServer,
   type Served,
-  servedUrl,
+  startCliServer,
 } from "./harness";
 
 /** The pipeline of the guide's Rust section (the YAML block that names tkeo/block.ts). */
@@ -74,7 +75,7 @@ async function logText(page: import("playwright-core").Page): Promise<string> {
 }
 
 describe.skipIf(!haveChromium)("a Rust block in mosaic serve's UI (Chromium)", () => {
-  let cli: ChildProcess;
+  let server: CliServer | undefined;
   let url: string;
   let browser: Chromium;
   let dir: string;
@@ -87,17 +88,14 @@ describe.skipIf(!haveChromium)("a Rust block in mosaic serve's UI (Chromium)", (
     if (made.code !== 0) throw new Error(`new-block failed: ${made.stderr}`);
     cargoBuild(join(dir, "tkeo"));
     writeFileSync(join(dir, "pipeline.yaml"), guidePipeline());
-    cli = startCli(["serve", join(dir, "pipeline.yaml"), "--port", "0"]);
-    url = await servedUrl(cli, 30_000);
+    server = await startCliServer(["serve", join(dir, "pipeline.yaml"), "--port", "0"]);
+    url = server.url;
     browser = await launchChromium();
   }, 300_000);
 
   afterAll(async () => {
     await browser?.close();
-    if (cli && cli.exitCode === null) {
-      cli.kill("SIGINT");
-      await new Promise((r) => cli.once("exit", r));
-    }
+    await server?.stop();
   });
 
   test("runs, is in the palette, and a rebuilt kernel reloads it visibly", async () => {

@@ -3,9 +3,8 @@
  * over the token-guarded WebSocket. Two tabs share the running pipeline; closing one leaves the
  * other's graph live; a page whose token is wrong gets no engine from the host.
  */
-import type { ChildProcess } from "node:child_process";
 import { afterAll, beforeAll, describe, expect, test } from "vitest";
-import { requireBuild, startCli } from "../integration/helpers";
+import { requireBuild } from "../integration/helpers";
 import {
   artifact,
   ensureWebBuild,
@@ -14,28 +13,26 @@ import {
   openApp,
   statuses,
   type Chromium,
-  servedUrl,
+  type CliServer,
+  startCliServer,
 } from "./harness";
 
 describe.skipIf(!haveChromium)("mosaic serve in Chromium", () => {
-  let cli: ChildProcess;
+  let server: CliServer | undefined;
   let url: string;
   let browser: Chromium;
 
   beforeAll(async () => {
     ensureWebBuild();
     requireBuild();
-    cli = startCli(["serve", "pipelines/demo.yaml", "--port", "0"]);
-    url = await servedUrl(cli, 20_000);
+    server = await startCliServer(["serve", "pipelines/demo.yaml", "--port", "0"], 20_000);
+    url = server.url;
     browser = await launchChromium();
   }, 60_000);
 
   afterAll(async () => {
     await browser?.close();
-    if (cli && cli.exitCode === null) {
-      cli.kill("SIGINT");
-      await new Promise((r) => cli.once("exit", r));
-    }
+    await server?.stop();
   });
 
   test("two tabs show the host's running demo; closing one leaves the other live", async () => {

@@ -5,11 +5,10 @@
  * saving the block's file reloads it: the pipeline restarts and the Log says so; a save with a
  * syntax error leaves the running version running and the Log names the file and line.
  */
-import type { ChildProcess } from "node:child_process";
 import { mkdirSync, readFileSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
 import { afterAll, beforeAll, describe, expect, test } from "vitest";
-import { requireBuild, runCli, startCli, tempDir } from "../integration/helpers";
+import { requireBuild, runCli, tempDir } from "../integration/helpers";
 import {
   artifact,
   ensureWebBuild,
@@ -19,8 +18,9 @@ import {
   ROOT,
   serveApp,
   type Chromium,
+  type CliServer,
   type Served,
-  servedUrl,
+  startCliServer,
 } from "./harness";
 
 /** The guide's block and pipeline, written into `dir`. */
@@ -49,7 +49,7 @@ async function logText(page: import("playwright-core").Page): Promise<string> {
 }
 
 describe.skipIf(!haveChromium)("a user's block in mosaic serve's UI (Chromium)", () => {
-  let cli: ChildProcess;
+  let server: CliServer | undefined;
   let url: string;
   let browser: Chromium;
   let dir: string;
@@ -59,17 +59,14 @@ describe.skipIf(!haveChromium)("a user's block in mosaic serve's UI (Chromium)",
     requireBuild();
     dir = tempDir("mosaic-e2e-user-blocks-");
     projectFromGuide(dir);
-    cli = startCli(["serve", join(dir, "pipeline.yaml"), "--port", "0"]);
-    url = await servedUrl(cli, 30_000);
+    server = await startCliServer(["serve", join(dir, "pipeline.yaml"), "--port", "0"]);
+    url = server.url;
     browser = await launchChromium();
   }, 60_000);
 
   afterAll(async () => {
     await browser?.close();
-    if (cli && cli.exitCode === null) {
-      cli.kill("SIGINT");
-      await new Promise((r) => cli.once("exit", r));
-    }
+    await server?.stop();
   });
 
   test("runs, is in the palette, and a saved file reloads it visibly", async () => {
