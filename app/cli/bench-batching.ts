@@ -1,15 +1,19 @@
 /**
- * `mosaic bench`: the batching sweep — each of its pipelines at each `--batching-ms`, shorter runs,
- * the figures side by side (CPU, engine wake-ups, delivery delay, UDP rate, samples lost).
+ * `mosaic bench`: the batching sweep — each of its pipelines at each `--batching-ms` (and each
+ * `--telemetry-hz` of the telemetry sweep), shorter runs, the figures side by side (CPU, engine
+ * wake-ups, delivery delay, UDP rate, samples lost).
  */
 import { runPipeline, type PipelineRunOptions } from "./bench-pipeline";
 import type { BatchingResult, BatchingRow, PipelineResult } from "./bench-types";
 import { loadAvg, round } from "./bench-util";
 import { pipelineDef, type BatchingDef, type PipelineDef } from "./bench-workloads";
 
+/** The CLI's telemetry rate when `--telemetry-hz` is not given (run-options.ts). */
+const CLI_TELEMETRY_HZ = 20;
+
 export async function runBatching(
   def: BatchingDef,
-  o: Omit<PipelineRunOptions, "batchingMs">,
+  o: Omit<PipelineRunOptions, "batchingMs" | "telemetryHz">,
 ): Promise<BatchingResult> {
   const before = loadAvg();
   const rows: BatchingRow[] = [];
@@ -17,7 +21,10 @@ export async function runBatching(
     const p = pipelineDef(id);
     if (!p) continue;
     for (const ms of def.intervalsMs) {
-      rows.push(sweepRow(p, ms, await runPipeline(p, { ...o, batchingMs: ms })));
+      for (const hz of def.telemetryHz ?? [undefined]) {
+        const r = await runPipeline(p, { ...o, batchingMs: ms, telemetryHz: hz });
+        rows.push(sweepRow(p, ms, hz ?? CLI_TELEMETRY_HZ, r));
+      }
     }
   }
   const failed = rows.filter((r) => !r.ok);
@@ -32,6 +39,7 @@ export async function runBatching(
     warmupSeconds: o.warmup,
     steadySeconds: o.steady,
     intervalsMs: def.intervalsMs,
+    ...(def.telemetryHz ? { telemetryHz: def.telemetryHz } : {}),
     rows,
     loadAvgBefore: before,
     loadAvgAfter: loadAvg(),
@@ -39,13 +47,17 @@ export async function runBatching(
   };
 }
 
-/** The sweep's row for pipeline `p` run at `ms`; a run at another interval than asked fails. */
-function sweepRow(p: PipelineDef, ms: number, r: PipelineResult): BatchingRow {
+/**
+ * The sweep's row for pipeline `p` run at `ms` with telemetry at `hz`; a run at another interval
+ * than asked fails.
+ */
+function sweepRow(p: PipelineDef, ms: number, hz: number, r: PipelineResult): BatchingRow {
   const sender = r.blocks.find((b) => b.name === "Sender")?.delay ?? null;
   const acq = r.blocks.find((b) => b.name === p.acquisition)?.delay ?? null;
   const row: BatchingRow = {
     pipeline: p.id,
     batchingMs: ms,
+    telemetryHz: hz,
     ok: r.ok,
     ...(r.error ? { error: r.error } : {}),
     cpuMedianPct: r.cpu?.medianPct ?? NaN,

@@ -25,6 +25,8 @@ export interface PipelineRunOptions {
   useNs: boolean;
   /** `--batching-ms` for this run (the batching sweep). */
   batchingMs?: number;
+  /** `--telemetry-hz` for this run (the telemetry sweep). */
+  telemetryHz?: number;
 }
 
 /** `inspect` sees the child run before its figures are taken (the soak's own accounting). */
@@ -95,6 +97,7 @@ function runArgs(def: PipelineDef, o: PipelineRunOptions, file: string, total: n
     String(o.warmup),
     ...(def.extra ?? []),
     ...(o.batchingMs !== undefined ? ["--batching-ms", String(o.batchingMs)] : []),
+    ...(o.telemetryHz !== undefined ? ["--telemetry-hz", String(o.telemetryHz)] : []),
   ];
 }
 

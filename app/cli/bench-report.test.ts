@@ -176,6 +176,7 @@ describe("bench report", () => {
         {
           pipeline: "delsys",
           batchingMs: 0,
+          telemetryHz: 20,
           ok: true,
           cpuMedianPct: 6.5,
           engineWakeupsPerS: 1931,
@@ -188,6 +189,7 @@ describe("bench report", () => {
         {
           pipeline: "delsys",
           batchingMs: 2,
+          telemetryHz: 20,
           ok: false,
           error: "boom",
           cpuMedianPct: NaN,
@@ -205,9 +207,47 @@ describe("bench report", () => {
     };
     const md = batchingMarkdown(r);
     expect(md).toContain(
-      "| delsys | 0 | 6.50 | 1931 | 0.100 / 0.400 | Delsys: 0.050 / 0.300 | 25.0130 | 0 | 0.50 / 0.40 / 0.30 |",
+      "| delsys | 0 | 20 | 6.50 | 1931 | 0.100 / 0.400 | Delsys: 0.050 / 0.300 | 25.0130 | 0 | 0.50 / 0.40 / 0.30 |",
     );
-    expect(md).toContain("| delsys | 2 | failed: boom | - | - | - | - | - | 0.50 / 0.40 / 0.30 |");
+    expect(md).toContain(
+      "| delsys | 2 | 20 | failed: boom | - | - | - | - | - | 0.50 / 0.40 / 0.30 |",
+    );
+  });
+
+  test("the telemetry sweep: runs in turn at each rate, the cost is the difference of the means", () => {
+    const row = (hz: number, cpu: number): BatchingResult["rows"][number] => ({
+      pipeline: "myo",
+      batchingMs: 5,
+      telemetryHz: hz,
+      ok: true,
+      cpuMedianPct: cpu,
+      engineWakeupsPerS: 100,
+      sender: null,
+      acquisition: null,
+      udpRateHz: 25,
+      samplesLost: 0,
+      loadAvgBefore: [0.5, 0.4, 0.3],
+    });
+    const r: BatchingResult = {
+      kind: "batching",
+      id: "telemetry",
+      title: "Telemetry cost",
+      ok: true,
+      warmupSeconds: 15,
+      steadySeconds: 15,
+      intervalsMs: [5],
+      telemetryHz: [20, 2, 20, 2],
+      rows: [row(20, 5), row(2, 3.5), row(20, 4), row(2, 2.5)],
+      loadAvgBefore: [0.5, 0.4, 0.3],
+      loadAvgAfter: [0.5, 0.4, 0.3],
+      killedAfterSummary: false,
+    };
+    const md = batchingMarkdown(r).join("\n");
+    expect(md).toContain("`--batching-ms` 5 and `--telemetry-hz` 20, 2, 20, 2 in turn");
+    expect(md).toContain("| myo | 5 | 2 | 2.50 | 100 |");
+    expect(md).toContain(
+      "- myo, batching 5 ms: 4.50 % at 20 Hz, 3.00 % at 2 Hz: telemetry at 20 Hz costs 1.50 % of one core",
+    );
   });
 
   test("--only: an id selects that workload alone, a group name or NAME* the group", () => {

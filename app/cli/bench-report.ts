@@ -59,22 +59,29 @@ export function udpMarkdown(
   return [...section(heading, r.title), r.ok ? udpLatencyLine(r) : `**Failed:** ${why}`, ""];
 }
 
-/** The batching sweep: CPU, wake-ups and delivery delay per pipeline and interval. */
+/**
+ * The batching sweep (and the telemetry sweep): CPU, wake-ups and delivery delay per pipeline,
+ * interval and telemetry rate.
+ */
 export function batchingMarkdown(r: BatchingResult, heading = "##"): string[] {
   if (r.rows.length === 0)
     return [...section(heading, r.title), ...failed(r.error ?? "nothing ran")];
+  const telemetry = r.telemetryHz
+    ? ` and \`--telemetry-hz\` ${r.telemetryHz.join(", ")} in turn`
+    : " (telemetry at 20 Hz)";
   return [
     ...section(heading, r.title),
-    `Each pipeline run with \`--batching-ms\` ${r.intervalsMs.join(", ")} (warm-up ${r.warmupSeconds} s, ` +
-      `steady state ${r.steadySeconds} s each). CPU: median of 1-s samples, % of one core. Wake-ups: ` +
-      "voluntary context switches per second of the busiest thread other than the CLI's main thread " +
-      "(the engine worker). Delay: delivery delay p50 / p99 (ms) since the warm-up. Samples lost: missed " +
-      "ticks + drops on the acquisition chain.",
+    `Each pipeline run with \`--batching-ms\` ${r.intervalsMs.join(", ")}${telemetry} (warm-up ` +
+      `${r.warmupSeconds} s, steady state ${r.steadySeconds} s each). CPU: median of 1-s samples, % of ` +
+      "one core. Wake-ups: voluntary context switches per second of the busiest thread other than the " +
+      "CLI's main thread (the engine worker). Delay: delivery delay p50 / p99 (ms) since the warm-up. " +
+      "Samples lost: missed ticks + drops on the acquisition chain.",
     "",
     ...table(
       [
         "pipeline",
         "batching (ms)",
+        "telemetry (Hz)",
         "CPU median (%)",
         "engine wake-ups/s",
         "Sender delay p50 / p99 (ms)",
@@ -86,7 +93,43 @@ export function batchingMarkdown(r: BatchingResult, heading = "##"): string[] {
       r.rows.map(batchingRow),
     ),
     "",
+    ...telemetryCost(r),
   ];
+}
+
+/**
+ * The telemetry sweep's reading: per pipeline and interval, the mean of the CPU medians at the
+ * highest telemetry rate minus that at the lowest (runs taken in turn, so drifts of the machine's
+ * load fall on both).
+ */
+function telemetryCost(r: BatchingResult): string[] {
+  const rates = r.telemetryHz;
+  if (!rates || rates.length < 2) return [];
+  const hi = Math.max(...rates);
+  const lo = Math.min(...rates);
+  const lines: string[] = [];
+  for (const id of new Set(r.rows.map((x) => x.pipeline))) {
+    for (const ms of r.intervalsMs) {
+      const cpu = (hz: number): number =>
+        meanOf(
+          r.rows
+            .filter((x) => x.ok && x.pipeline === id && x.batchingMs === ms && x.telemetryHz === hz)
+            .map((x) => x.cpuMedianPct),
+        );
+      const a = cpu(hi);
+      const b = cpu(lo);
+      if (!(Number.isFinite(a) && Number.isFinite(b))) continue;
+      lines.push(
+        `- ${id}, batching ${ms} ms: ${fmt(a, 2)} % at ${hi} Hz, ${fmt(b, 2)} % at ${lo} Hz: ` +
+          `telemetry at ${hi} Hz costs ${fmt(a - b, 2)} % of one core`,
+      );
+    }
+  }
+  return lines.length ? [...lines, ""] : [];
+}
+
+function meanOf(xs: number[]): number {
+  return xs.length ? xs.reduce((a, b) => a + b, 0) / xs.length : NaN;
 }
 
 function batchingRow(x: BatchingRow): string[] {
@@ -95,6 +138,7 @@ function batchingRow(x: BatchingRow): string[] {
     return [
       x.pipeline,
       String(x.batchingMs),
+      String(x.telemetryHz),
       `failed: ${x.error ?? "?"}`,
       ...dashes,
       load(x.loadAvgBefore),
@@ -103,6 +147,7 @@ function batchingRow(x: BatchingRow): string[] {
   return [
     x.pipeline,
     String(x.batchingMs),
+    String(x.telemetryHz),
     fmt(x.cpuMedianPct, 2),
     fmt(x.engineWakeupsPerS, 0),
     x.sender ? `${fmt(x.sender.p50Ms, 3)} / ${fmt(x.sender.p99Ms, 3)}` : "-",

@@ -213,6 +213,8 @@ export interface UdpResult {
 export interface BatchingRow {
   pipeline: string;
   batchingMs: number;
+  /** Telemetry per second of the run (`--telemetry-hz`). */
+  telemetryHz: number;
   ok: boolean;
   error?: string;
   cpuMedianPct: number;
@@ -234,6 +236,8 @@ export interface BatchingResult {
   warmupSeconds: number;
   steadySeconds: number;
   intervalsMs: number[];
+  /** The telemetry rates swept at each interval (the telemetry sweep only). */
+  telemetryHz?: number[];
   rows: BatchingRow[];
   loadAvgBefore: number[];
   loadAvgAfter: number[];

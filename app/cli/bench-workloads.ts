@@ -33,6 +33,11 @@ export interface BatchingDef {
   /** Ids of the pipeline workloads swept. */
   pipelines: string[];
   intervalsMs: number[];
+  /**
+   * Telemetry rates (`--telemetry-hz`) run one after the other at each interval, so that their
+   * difference is the cost of telemetry; left out: the CLI's default (20 Hz, as the UI) only.
+   */
+  telemetryHz?: number[];
 }
 export interface ReplayDef {
   kind: "replay";
@@ -209,6 +214,15 @@ export const WORKLOADS: WorkloadDef[] = [
       "Batching sweep — the Delsys and Myo pipelines at --batching-ms 0, 1, 2, 5, 10: CPU, engine wake-ups, delivery delay",
     pipelines: ["delsys", "myo"],
     intervalsMs: [0, 1, 2, 5, 10],
+  },
+  {
+    kind: "batching",
+    id: "telemetry",
+    title:
+      "Telemetry cost — the Myo and Delsys pipelines at the default batching interval with telemetry at 20 Hz (the UI's rate, the CLI's default) and at 2 Hz: CPU",
+    pipelines: ["myo", "delsys"],
+    intervalsMs: [5], // the default (DEFAULT_BATCHING_S, app/engine/runtime/runtime.ts)
+    telemetryHz: [20, 2, 20, 2],
   },
   {
     kind: "soak",
