@@ -4,17 +4,20 @@
  * each of its inputs, and its control panel. A menu in the WAI-ARIA sense: arrow keys move, Enter
  * runs, Escape closes and gives the focus back.
  */
-import { useEffect, useLayoutEffect, useRef, useState } from "react";
+import {
+  useEffect,
+  useLayoutEffect,
+  useRef,
+  useState,
+  type Dispatch,
+  type RefObject,
+  type SetStateAction,
+} from "react";
 import type { BlockInfo } from "../../engine/protocol";
 import { useTelemetrySelector } from "../client/hooks";
-import { gestureNames } from "../app/gesture-names";
+import { menuItems, type MenuItem } from "./block-menu-items";
 
-export interface MenuItem {
-  label: string;
-  hint?: string;
-  run(): void;
-  separatorBefore?: boolean;
-}
+export type { MenuItem } from "./block-menu-items";
 
 interface Props {
   block: BlockInfo;
@@ -25,10 +28,81 @@ interface Props {
   onInvoke(action: string, arg: unknown, label: string): void;
 }
 
-const BUILT_IN_INPUT_ACTIONS = new Set(["subscribe", "unsubscribe"]);
+type Point = { x: number; y: number };
+type MenuRef = RefObject<HTMLDivElement | null>;
 
 export function BlockMenu({ block, anchor, panelOpen, onClose, onTogglePanel, onInvoke }: Props) {
-  const subscribed = useTelemetrySelector(
+  const subscribed = useSubscribedInputs(block);
+  const items = menuItems(block, subscribed, panelOpen, onTogglePanel, onInvoke);
+  const ref = useRef<HTMLDivElement>(null);
+  const [active, setActive] = useState(0);
+  const pos = useInsideWindow(ref, anchor);
+  useFocusItem(ref, active);
+  useCloseWhenAway(ref, onClose);
+  return (
+    <div
+      ref={ref}
+      className="block-menu"
+      role="menu"
+      aria-label={`Actions of ${block.name}`}
+      data-menu={block.name}
+      style={{ left: pos.x, top: pos.y }}
+      onKeyDown={menuKeys(items.length, setActive, onClose)}
+      onContextMenu={(e) => e.preventDefault()}
+    >
+      <div className="block-menu__title" aria-hidden="true">
+        {block.name} <span>{block.type}</span>
+      </div>
+      {items.map((it, i) => (
+        <BlockMenuItem
+          key={`${i}:${it.label}`}
+          item={it}
+          focusable={i === active}
+          onHover={() => setActive(i)}
+          onClose={onClose}
+        />
+      ))}
+    </div>
+  );
+}
+
+/** One item: a separator before it if it starts a group, and its key (a short hint) on the right. */
+function BlockMenuItem({
+  item,
+  focusable,
+  onHover,
+  onClose,
+}: {
+  item: MenuItem;
+  focusable: boolean;
+  onHover(): void;
+  onClose(): void;
+}) {
+  return (
+    <div role="none">
+      {item.separatorBefore ? <div className="block-menu__sep" role="separator" /> : null}
+      <button
+        type="button"
+        role="menuitem"
+        tabIndex={focusable ? 0 : -1}
+        className="block-menu__item"
+        title={item.hint}
+        onMouseEnter={onHover}
+        onClick={() => {
+          onClose();
+          item.run();
+        }}
+      >
+        <span>{item.label}</span>
+        {item.hint && item.hint.length <= 8 ? <kbd>{item.hint}</kbd> : null}
+      </button>
+    </div>
+  );
+}
+
+/** "true" or "false" per input: the live edge's state, else the graph's. */
+function useSubscribedInputs(block: BlockInfo): string[] {
+  return useTelemetrySelector(
     (t) =>
       block.inputs
         .map((inp, i) => {
@@ -38,52 +112,11 @@ export function BlockMenu({ block, anchor, panelOpen, onClose, onTogglePanel, on
         .join(","),
     Object.is,
   ).split(",");
+}
 
-  const items: MenuItem[] = [
-    {
-      label: panelOpen ? "Close control panel" : "Open control panel",
-      hint: "Enter",
-      run: onTogglePanel,
-    },
-  ];
-  let first = true;
-  for (const a of block.actions) {
-    if (BUILT_IN_INPUT_ACTIONS.has(a.name)) continue;
-    if (block.type === "EmgSimulator" && a.name === "setGesture") {
-      gestureNames(block).forEach((g, i) => {
-        items.push({
-          label: `Gesture: ${g}`,
-          ...(i < 9 ? { hint: `key ${i + 1}` } : {}),
-          run: () => onInvoke("setGesture", g, `Gesture: ${g}`),
-          separatorBefore: first && i === 0,
-        });
-        first = false;
-      });
-      continue;
-    }
-    items.push({
-      label: a.label,
-      ...(a.description !== undefined ? { hint: a.description } : {}),
-      run: () => onInvoke(a.name, undefined, a.label),
-      separatorBefore: first,
-    });
-    first = false;
-  }
-  block.inputs.forEach((inp, i) => {
-    const on = subscribed[i] === "true";
-    const label = `${on ? "Unsubscribe" : "Subscribe"} input ${inp.source}`;
-    items.push({
-      label,
-      run: () => onInvoke(on ? "unsubscribe" : "subscribe", i, label),
-      separatorBefore: i === 0,
-    });
-  });
-
-  const ref = useRef<HTMLDivElement>(null);
-  const [active, setActive] = useState(0);
+/** The menu's position: at the anchor, moved to keep the menu inside the window. */
+function useInsideWindow(ref: MenuRef, anchor: Point): Point {
   const [pos, setPos] = useState(anchor);
-
-  // Keep the menu inside the window.
   useLayoutEffect(() => {
     const el = ref.current;
     if (!el) return;
@@ -92,12 +125,19 @@ export function BlockMenu({ block, anchor, panelOpen, onClose, onTogglePanel, on
     const y = Math.max(4, Math.min(anchor.y, window.innerHeight - r.height - 4));
     setPos({ x, y });
   }, [anchor.x, anchor.y]);
+  return pos;
+}
 
+/** The focus follows the active item. */
+function useFocusItem(ref: MenuRef, active: number): void {
   useEffect(() => {
     const el = ref.current?.querySelectorAll<HTMLElement>("[role=menuitem]")[active];
     el?.focus();
   }, [active]);
+}
 
+/** A pointer down outside the menu, or the window losing the focus, closes it. */
+function useCloseWhenAway(ref: MenuRef, onClose: () => void): void {
   useEffect(() => {
     const away = (e: PointerEvent): void => {
       if (ref.current && !ref.current.contains(e.target as Node)) onClose();
@@ -110,9 +150,11 @@ export function BlockMenu({ block, anchor, panelOpen, onClose, onTogglePanel, on
       window.removeEventListener("blur", blur);
     };
   }, [onClose]);
+}
 
-  const onKeyDown = (e: React.KeyboardEvent): void => {
-    const n = items.length;
+/** Arrows, Home and End move among the `n` items; Escape and Tab close the menu. */
+function menuKeys(n: number, setActive: Dispatch<SetStateAction<number>>, onClose: () => void) {
+  return (e: React.KeyboardEvent): void => {
     if (e.key === "ArrowDown") setActive((a) => (a + 1) % n);
     else if (e.key === "ArrowUp") setActive((a) => (a - 1 + n) % n);
     else if (e.key === "Home") setActive(0);
@@ -122,41 +164,4 @@ export function BlockMenu({ block, anchor, panelOpen, onClose, onTogglePanel, on
     e.preventDefault();
     e.stopPropagation();
   };
-
-  return (
-    <div
-      ref={ref}
-      className="block-menu"
-      role="menu"
-      aria-label={`Actions of ${block.name}`}
-      data-menu={block.name}
-      style={{ left: pos.x, top: pos.y }}
-      onKeyDown={onKeyDown}
-      onContextMenu={(e) => e.preventDefault()}
-    >
-      <div className="block-menu__title" aria-hidden="true">
-        {block.name} <span>{block.type}</span>
-      </div>
-      {items.map((it, i) => (
-        <div key={`${i}:${it.label}`} role="none">
-          {it.separatorBefore ? <div className="block-menu__sep" role="separator" /> : null}
-          <button
-            type="button"
-            role="menuitem"
-            tabIndex={i === active ? 0 : -1}
-            className="block-menu__item"
-            title={it.hint}
-            onMouseEnter={() => setActive(i)}
-            onClick={() => {
-              onClose();
-              it.run();
-            }}
-          >
-            <span>{it.label}</span>
-            {it.hint && it.hint.length <= 8 ? <kbd>{it.hint}</kbd> : null}
-          </button>
-        </div>
-      ))}
-    </div>
-  );
 }
