@@ -5,6 +5,7 @@
 import { failed, fmt, fmtRateSI, load, section, table } from "./bench-format";
 import { pipelineMarkdown } from "./bench-report-pipeline";
 import { soakMarkdown } from "./bench-soak";
+import { quantile } from "./bench-stats";
 import type {
   BatchingResult,
   BatchingRow,
@@ -98,9 +99,9 @@ export function batchingMarkdown(r: BatchingResult, heading = "##"): string[] {
 }
 
 /**
- * The telemetry sweep's reading: per pipeline and interval, the mean of the CPU medians at the
- * highest telemetry rate minus that at the lowest (runs taken in turn, so drifts of the machine's
- * load fall on both).
+ * The telemetry sweep's reading: per pipeline and interval, the CPU median of each run at the
+ * highest telemetry rate minus that of the run at the lowest right after it, and their median
+ * (pairs taken one after the other, so that a drift of the machine's load falls on both).
  */
 function telemetryCost(r: BatchingResult): string[] {
   const rates = r.telemetryHz;
@@ -110,26 +111,35 @@ function telemetryCost(r: BatchingResult): string[] {
   const lines: string[] = [];
   for (const id of new Set(r.rows.map((x) => x.pipeline))) {
     for (const ms of r.intervalsMs) {
-      const cpu = (hz: number): number =>
-        meanOf(
-          r.rows
-            .filter((x) => x.ok && x.pipeline === id && x.batchingMs === ms && x.telemetryHz === hz)
-            .map((x) => x.cpuMedianPct),
-        );
-      const a = cpu(hi);
-      const b = cpu(lo);
-      if (!(Number.isFinite(a) && Number.isFinite(b))) continue;
+      const runs = r.rows.filter((x) => x.ok && x.pipeline === id && x.batchingMs === ms);
+      const d = pairDifferences(runs, hi, lo);
+      if (d.length === 0) continue;
       lines.push(
-        `- ${id}, batching ${ms} ms: ${fmt(a, 2)} % at ${hi} Hz, ${fmt(b, 2)} % at ${lo} Hz: ` +
-          `telemetry at ${hi} Hz costs ${fmt(a - b, 2)} % of one core`,
+        `- ${id}, batching ${ms} ms: telemetry at ${hi} Hz instead of ${lo} Hz costs ` +
+          `${d.map((x) => fmt(x, 2)).join(", ")} % of one core in ${d.length} pair(s) of runs ` +
+          `(median ${fmt(quantile(d, 0.5), 2)} %)`,
       );
     }
   }
-  return lines.length ? [...lines, ""] : [];
+  if (lines.length === 0) return [];
+  return [
+    ...lines,
+    "",
+    "Single pairs swing with the machine's load (a 15-s run's median moves by a percent on a shared " +
+      "machine); the median of the pairs is the figure.",
+    "",
+  ];
 }
 
-function meanOf(xs: number[]): number {
-  return xs.length ? xs.reduce((a, b) => a + b, 0) / xs.length : NaN;
+/** CPU at `hi` minus CPU at `lo` for each run at `hi` directly followed by one at `lo`. */
+function pairDifferences(runs: BatchingRow[], hi: number, lo: number): number[] {
+  const d: number[] = [];
+  for (let i = 0; i + 1 < runs.length; i++) {
+    const a = runs[i]!;
+    const b = runs[i + 1]!;
+    if (a.telemetryHz === hi && b.telemetryHz === lo) d.push(a.cpuMedianPct - b.cpuMedianPct);
+  }
+  return d;
 }
 
 function batchingRow(x: BatchingRow): string[] {

@@ -219,10 +219,10 @@ export const WORKLOADS: WorkloadDef[] = [
     kind: "batching",
     id: "telemetry",
     title:
-      "Telemetry cost — the Myo and Delsys pipelines at the default batching interval with telemetry at 20 Hz (the UI's rate, the CLI's default) and at 2 Hz: CPU",
-    pipelines: ["myo", "delsys"],
+      "Telemetry cost — the Myo pipeline at the default batching interval with telemetry at 20 Hz (the UI's rate, the CLI's default) and at 2 Hz, in turn: CPU",
+    pipelines: ["myo"],
     intervalsMs: [5], // the default (DEFAULT_BATCHING_S, app/engine/runtime/runtime.ts)
-    telemetryHz: [20, 2, 20, 2],
+    telemetryHz: [20, 2, 20, 2, 20, 2],
   },
   {
     kind: "soak",
