@@ -3,7 +3,7 @@
  * finish) and the targets rendered from fixed results. bench-fixture.json is the latest.json of a
  * `mosaic bench --quick --only myo,delsys-loaded,timer,replay-32,learn,udp,batching` run, kept as
  * it was written (machine, load averages, commit); bench-fixture.md.txt is the latest.md that run
- * wrote. The variants change the fixture to reach the branches a quick run does not (failures,
+ * wrote, re-rendered once by the report code when the sweep's table got its telemetry column. The variants change the fixture to reach the branches a quick run does not (failures,
  * workloads not run, a Python block, a lingering child, …); their expected text,
  * bench-fixture-variants.md.txt, was written by the report code before it was split into modules.
  * Regenerate it only for an intended change of the output: BENCH_GOLDEN_WRITE=1 npx vitest run

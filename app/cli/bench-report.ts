@@ -69,7 +69,7 @@ export function batchingMarkdown(r: BatchingResult, heading = "##"): string[] {
     return [...section(heading, r.title), ...failed(r.error ?? "nothing ran")];
   const telemetry = r.telemetryHz
     ? ` and \`--telemetry-hz\` ${r.telemetryHz.join(", ")} in turn`
-    : " (telemetry at 20 Hz)";
+    : " and telemetry at 20 Hz";
   return [
     ...section(heading, r.title),
     `Each pipeline run with \`--batching-ms\` ${r.intervalsMs.join(", ")}${telemetry} (warm-up ` +
@@ -148,7 +148,7 @@ function batchingRow(x: BatchingRow): string[] {
     return [
       x.pipeline,
       String(x.batchingMs),
-      String(x.telemetryHz),
+      String(x.telemetryHz ?? 20),
       `failed: ${x.error ?? "?"}`,
       ...dashes,
       load(x.loadAvgBefore),
@@ -157,7 +157,7 @@ function batchingRow(x: BatchingRow): string[] {
   return [
     x.pipeline,
     String(x.batchingMs),
-    String(x.telemetryHz),
+    String(x.telemetryHz ?? 20),
     fmt(x.cpuMedianPct, 2),
     fmt(x.engineWakeupsPerS, 0),
     x.sender ? `${fmt(x.sender.p50Ms, 3)} / ${fmt(x.sender.p99Ms, 3)}` : "-",

@@ -213,8 +213,9 @@ export interface UdpResult {
 export interface BatchingRow {
   pipeline: string;
   batchingMs: number;
-  /** Telemetry per second of the run (`--telemetry-hz`). */
-  telemetryHz: number;
+  /** Telemetry per second of the run (`--telemetry-hz`); absent in results written before the
+   * telemetry sweep, whose runs all had the CLI's default, 20. */
+  telemetryHz?: number;
   ok: boolean;
   error?: string;
   cpuMedianPct: number;
