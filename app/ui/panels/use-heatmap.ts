@@ -36,6 +36,7 @@ import {
   type CellImage,
   type Layout,
 } from "./heatmap-draw";
+import { useSmoother } from "./use-smoother";
 import type { OutputInfo } from "./view-props";
 
 export interface HeatmapGrid {
@@ -84,15 +85,6 @@ export function useHeatmapGrid(
     [output.shape, declared, n, gridRows, gridCols, settings.columnMajor],
   );
   return { reduce, declared, gridRows, gridCols, layout };
-}
-
-/** One Smoother per number of values, following the settings; reset when the reduction changes. */
-function useSmoother(n: number, reduce: Reduce, tauS: number): Smoother {
-  const smoother = useMemo(() => new Smoother(n, reduce, tauS), [n]);
-  smoother.mode = reduce;
-  smoother.tauS = tauS;
-  useEffect(() => smoother.reset(), [reduce, smoother]);
-  return smoother;
 }
 
 /** The frame loop's state, told the latest settings and layout (a new layout redraws). */

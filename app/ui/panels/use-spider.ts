@@ -2,7 +2,7 @@
  * The spider plot's hooks: the values it receives (smoothed, the newest row of each event) and
  * drawing them once per frame when new data arrived, on the fixed or autoscaled range.
  */
-import { useCallback, useEffect, useMemo, useRef, useState, type RefObject } from "react";
+import { useCallback, useEffect, useRef, useState, type RefObject } from "react";
 import type { BlockInfo, DataMessage } from "../../engine/protocol";
 import { useBlockData } from "../client/hooks";
 import { Smoother, StickyRange, channelLabel, finiteExtent, type Reduce } from "./channels";
@@ -10,6 +10,7 @@ import { readTheme, useWidth, type Theme } from "./canvas";
 import { countDraw, onFrame, viewStats } from "./frame";
 import type { SpiderSettings } from "./spider";
 import { HEIGHT, drawBars, drawSpider } from "./spider-draw";
+import { useSmoother } from "./use-smoother";
 import type { OutputInfo } from "./view-props";
 
 /** What the frame loop reads and writes between renders. */
@@ -55,15 +56,6 @@ export function useSpiderCanvas(
   useWidth(wrap, onResize);
   useSpiderFrames(canvas, live, smoother, output, n, active, statsKey);
   return { canvas, wrap, hasData };
-}
-
-/** One Smoother per number of values, following the settings; reset when the reduction changes. */
-function useSmoother(n: number, reduce: Reduce, tauS: number): Smoother {
-  const smoother = useMemo(() => new Smoother(n, reduce, tauS), [n]);
-  smoother.mode = reduce;
-  smoother.tauS = tauS;
-  useEffect(() => smoother.reset(), [reduce, smoother]);
-  return smoother;
 }
 
 /** The frame loop's state, told the latest settings. */
