@@ -143,6 +143,8 @@ class ChildMonitor {
   /** The steady-state window, seconds since spawn (unbounded until `warmup-done`). */
   private steadyFrom: number;
   private steadyUntil: number;
+  /** The child's time at the end of the warm-up (its `warmup-done` line), UNIX seconds. */
+  private warmupT: number | undefined;
   private steadySamples = 0;
   private last: CpuMark | undefined;
   /** The mark at the start of the steady state (per-thread breakdown). */
@@ -300,7 +302,7 @@ class ChildMonitor {
         this.onTelemetry(m as unknown as Telemetry);
         break;
       case "warmup-done":
-        this.onWarmupDone();
+        this.onWarmupDone(Number(m.t));
         break;
       case "event":
         this.onEvent(m);
@@ -314,10 +316,17 @@ class ChildMonitor {
     }
   }
 
-  /** Counts the blocks' statuses in the window; before it, keeps the line as the baseline. */
+  /**
+   * Counts the blocks' statuses of the reports in the window; a report before it is the baseline.
+   * With a warm-up, a report belongs where its own time `t` falls (the CLI hands reports over in
+   * groups of a quarter second, so a line can arrive after `warmup-done` and still be from the
+   * warm-up); without one, where it arrives.
+   */
   private onTelemetry(t: Telemetry): void {
-    const now = this.since();
-    if (now > this.steadyFrom && now <= this.steadyUntil) {
+    const at = this.warmupT === undefined ? this.since() : t.t - this.warmupT;
+    const from = this.warmupT === undefined ? this.steadyFrom : 0;
+    const until = this.warmupT === undefined ? this.steadyUntil : this.windowSamples;
+    if (at > from && at <= until) {
       this.res.telemetryLines++;
       for (const b of t.blocks) {
         let c = this.res.statusCounts.get(b.name);
@@ -325,11 +334,14 @@ class ChildMonitor {
         c[b.status]++;
       }
     }
-    if (this.steadyFrom === Infinity) this.res.baseline = t;
+    if (this.steadyFrom === Infinity || (this.warmupT !== undefined && at <= 0)) {
+      this.res.baseline = t;
+    }
     this.lastTelemetry = t;
   }
 
-  private onWarmupDone(): void {
+  private onWarmupDone(t: number): void {
+    this.warmupT = t;
     // The steady state starts now: close the last (partial) warm-up sample and restart the
     // 1-s samples on this instant.
     const pid = this.pid;

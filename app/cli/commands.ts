@@ -68,7 +68,9 @@ ${testBlockHelp()}
         --log-dir DIR  base folder for relative Path logs (default: the pipeline's folder)
         --start T      virtual clock start time, UNIX seconds (default 0)
         --warmup S     reset the timing statistics (ΔT, lateness) after S seconds
-        --telemetry-hz N  telemetry (status, rates) per second, default 20 (as the UI)
+        --telemetry-hz N  telemetry (status, rates) per second, default 20 (as the UI);
+                       the engine hands it over a quarter second at a time (--json lines
+                       come in groups, each report with its own time)
         --simulate-devices  run without hardware: every device block becomes a simulator
                        of the same output shape and rate (EmgSimulator for EMG armbands and
                        probes, ImuSimulator for IMUs), every output device (BlenderArm, Hannes,

@@ -29,12 +29,21 @@ import { pipelineCatalog } from "../engine/user-blocks";
 import { flushWrites, nodeResources } from "./resources";
 import { loadBlockModule } from "./user-blocks";
 import { clockFromBase } from "./time-base";
+import { TelemetryOutbox } from "./telemetry-outbox";
 import type { HostToWorker, InitMessage, TelemetryReport, WorkerToHost } from "./worker-protocol";
 
 const port = parentPort;
 if (!port) throw new Error("engine.worker must run in a worker thread");
 
-const post = (m: WorkerToHost): void => port.postMessage(m);
+/** Telemetry waits here for its group (see TelemetryOutbox); other messages go at once. */
+const outbox = new TelemetryOutbox((reports) =>
+  port.postMessage({ type: "telemetry", reports } satisfies WorkerToHost),
+);
+/** Posts a message to the host, after the telemetry that waits (the host sees them in order). */
+const post = (m: WorkerToHost): void => {
+  outbox.flush();
+  port.postMessage(m);
+};
 
 let rt: Runtime | undefined;
 let loop: RealtimeLoop | undefined;
@@ -177,6 +186,7 @@ function start(): void {
   const runtime = rt;
   rt.start();
   const telemetryIntervalS = 1 / init.telemetryHz;
+  outbox.group = init.telemetryGroup;
   if (init.mode === "virtual") {
     const clock = vclock!;
     const until = init.virtualStart + init.virtualDuration;
@@ -186,7 +196,7 @@ function start(): void {
       const r = runVirtual(runtime, clock, until, 20);
       if (performance.now() - lastTel >= telemetryIntervalS * 1000) {
         lastTel = performance.now();
-        post({ type: "telemetry", report: report(runtime.telemetry()) });
+        outbox.add(report(runtime.telemetry()));
       }
       if (r === "yield") setImmediate(chunk);
       else if (r === "waiting") {
@@ -207,7 +217,7 @@ function start(): void {
     doorbell,
     precision: init.precision,
     telemetryIntervalS,
-    onTelemetry: (at) => post({ type: "telemetry", report: report(runtime.telemetry(at)) }),
+    onTelemetry: (at) => outbox.add(report(runtime.telemetry(at))),
     onFinished: () => post({ type: "finished", telemetry: runtime.telemetry() }),
   });
   rt.onWake = () => loop?.wake();

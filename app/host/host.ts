@@ -1,8 +1,8 @@
 /**
  * The Node host: loads a pipeline, runs its blocks in engine workers (one per `Worker:` name,
  * "main" by default; the main thread never runs blocks), links cross-worker edges through SAB
- * rings, writes logs, and merges telemetry. The CLI, the HTTP/WebSocket server and Electron all
- * drive a pipeline through this class.
+ * rings, writes logs, and merges telemetry. `mosaic run` (and the bench's UDP latency run) drive
+ * a pipeline through this class; the server and Electron run editing sessions (session-hub.ts).
  */
 import { existsSync, readFileSync } from "node:fs";
 import { dirname, join, resolve } from "node:path";
@@ -18,6 +18,7 @@ import { bleHub } from "../../native-bridges/ble-proxy";
 import type { BleBridge } from "../engine/io";
 import { LogWriter } from "./log-writer";
 import { takeTimeBase } from "./time-base";
+import { telemetryGroup } from "./telemetry-outbox";
 import type {
   ClockMode,
   ControlOp,
@@ -36,6 +37,12 @@ export interface HostOptions {
   virtualStart?: number;
   virtualDuration?: number;
   telemetryHz?: number;
+  /**
+   * Seconds of telemetry a worker gathers before sending it to this thread, as one message
+   * (default 0.25: the CLI's table redraws 4 times a second, and this thread then wakes 4 times a
+   * second instead of 20; every report still arrives, each with its own time); 0: each at once.
+   */
+  telemetryGroupS?: number;
   /**
    * The batching interval, s, for blocks that do not set their own: overrides the pipeline's
    * `Pipeline: { BatchingMs }` (undefined: the file's, else the default).
@@ -203,6 +210,7 @@ export class Host {
       virtualStart: opts.virtualStart ?? 0,
       virtualDuration: opts.virtualDuration ?? Infinity,
       telemetryHz: opts.telemetryHz ?? 20,
+      telemetryGroupS: opts.telemetryGroupS ?? 0.25,
       batchingS: opts.batchingS,
       simulateDevices: opts.simulateDevices,
       ble: opts.ble,
@@ -225,6 +233,7 @@ export class Host {
       ...(plan ? { plan } : {}),
       precision: host.options.precision,
       telemetryHz: host.options.telemetryHz,
+      telemetryGroup: telemetryGroup(host.options.telemetryGroupS, host.options.telemetryHz),
       ...(host.options.batchingS !== undefined ? { batchingS: host.options.batchingS } : {}),
       ...(host.options.simulateDevices ? { simulateDevices: host.options.simulateDevices } : {}),
     });
@@ -356,11 +365,7 @@ export class Host {
         this.logWriter.close(`${st.name}:${m.id}`);
         break;
       case "telemetry":
-        st.report = m.report;
-        st.telemetry = undefined;
-        for (const e of m.report.events) this.events.event?.(e);
-        m.report.events = [];
-        this.reportTelemetry();
+        this.reportGroup(st, m.reports);
         break;
       case "finished":
       case "stopped":
@@ -499,6 +504,17 @@ export class Host {
   private reportTelemetry(): void {
     if (this.events.telemetry) this.events.telemetry(this.telemetry());
     if (this.events.telemetryLine) this.events.telemetryLine(this.telemetryLine());
+  }
+
+  /** A worker's group of reports (oldest first): each one's events and telemetry in turn. */
+  private reportGroup(st: WorkerState, reports: TelemetryReport[]): void {
+    for (const r of reports) {
+      st.report = r;
+      st.telemetry = undefined;
+      for (const e of r.events) this.events.event?.(e);
+      r.events = [];
+      this.reportTelemetry();
+    }
   }
 
   /** The telemetry of one worker as objects (its report parsed once). */

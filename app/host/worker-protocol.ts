@@ -25,6 +25,11 @@ export interface InitMessage {
   plan?: Plan;
   precision: boolean;
   telemetryHz: number;
+  /**
+   * Telemetry reports per message to the host (1: each at once). See TelemetryOutbox: the CLI
+   * sends a quarter second's at a time, and its thread wakes 4 times a second instead of 20.
+   */
+  telemetryGroup: number;
   /** Batching interval for blocks without their own `BatchingMs`, s (the CLI's --batching-ms). */
   batchingS?: number;
   /** Replace device blocks by simulators (`mosaic run --simulate-devices`); undefined: off. */
@@ -81,7 +86,7 @@ export type WorkerToHost =
       ring: SabRingInit;
     }
   | { type: "log-close"; id: number }
-  | { type: "telemetry"; report: TelemetryReport }
+  | { type: "telemetry"; reports: TelemetryReport[] }
   | { type: "reply"; id: number; ok: boolean; message: string }
   | { type: "finished"; telemetry: Telemetry }
   | { type: "stopped"; telemetry: Telemetry }
