@@ -5,11 +5,9 @@
  */
 import { runPipeline, type PipelineRunOptions } from "./bench-pipeline";
 import type { BatchingResult, BatchingRow, PipelineResult } from "./bench-types";
+import { DEFAULT_TELEMETRY_HZ } from "../host/worker-protocol";
 import { loadAvg, round } from "./bench-util";
 import { pipelineDef, type BatchingDef, type PipelineDef } from "./bench-workloads";
-
-/** The CLI's telemetry rate when `--telemetry-hz` is not given (run-options.ts). */
-const CLI_TELEMETRY_HZ = 20;
 
 export async function runBatching(
   def: BatchingDef,
@@ -23,7 +21,7 @@ export async function runBatching(
     for (const ms of def.intervalsMs) {
       for (const hz of def.telemetryHz ?? [undefined]) {
         const r = await runPipeline(p, { ...o, batchingMs: ms, telemetryHz: hz });
-        rows.push(sweepRow(p, ms, hz ?? CLI_TELEMETRY_HZ, r));
+        rows.push(sweepRow(p, ms, hz ?? DEFAULT_TELEMETRY_HZ, r));
       }
     }
   }

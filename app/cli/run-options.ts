@@ -9,6 +9,7 @@ import { NilsPodSimulator } from "../devices/nilspod-simulator";
 import type { BleBridge } from "../engine/io";
 import type { SimulateOptions } from "../engine/pipeline/simulate";
 import type { HostOptions } from "../host/host";
+import { DEFAULT_TELEMETRY_HZ } from "../host/worker-protocol";
 
 export const SIMULATE_ARGS = {
   "simulate-devices": { type: "boolean", default: false },
@@ -103,7 +104,8 @@ function runNumbers(
   if (!(warmup >= 0)) {
     return `mosaic run: --warmup must be a number of seconds, not '${values.warmup}'`;
   }
-  const telemetryHz = values["telemetry-hz"] !== undefined ? Number(values["telemetry-hz"]) : 20;
+  const telemetryHz =
+    values["telemetry-hz"] !== undefined ? Number(values["telemetry-hz"]) : DEFAULT_TELEMETRY_HZ;
   if (!(telemetryHz > 0 && telemetryHz <= 100)) {
     return `mosaic run: --telemetry-hz must be between 0 and 100, not '${values["telemetry-hz"]}'`;
   }

@@ -19,12 +19,13 @@ import type { BleBridge } from "../engine/io";
 import { LogWriter } from "./log-writer";
 import { takeTimeBase } from "./time-base";
 import { telemetryGroup } from "./telemetry-outbox";
-import type {
-  ClockMode,
-  ControlOp,
-  HostToWorker,
-  TelemetryReport,
-  WorkerToHost,
+import {
+  DEFAULT_TELEMETRY_HZ,
+  type ClockMode,
+  type ControlOp,
+  type HostToWorker,
+  type TelemetryReport,
+  type WorkerToHost,
 } from "./worker-protocol";
 
 export interface HostOptions {
@@ -209,7 +210,7 @@ export class Host {
       logDir: opts.logDir ?? dirname(full),
       virtualStart: opts.virtualStart ?? 0,
       virtualDuration: opts.virtualDuration ?? Infinity,
-      telemetryHz: opts.telemetryHz ?? 20,
+      telemetryHz: opts.telemetryHz ?? DEFAULT_TELEMETRY_HZ,
       telemetryGroupS: opts.telemetryGroupS ?? 0.25,
       batchingS: opts.batchingS,
       simulateDevices: opts.simulateDevices,

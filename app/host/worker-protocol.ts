@@ -10,6 +10,9 @@ import type { TimeBase } from "./time-base";
 
 export type ClockMode = "realtime" | "virtual";
 
+/** Telemetry per second when none is asked for (`mosaic run`, the Host): the UI's rate. */
+export const DEFAULT_TELEMETRY_HZ = 20;
+
 export interface InitMessage {
   type: "init";
   file: string;
