@@ -128,6 +128,7 @@ export class StimulusRun {
     // MOSAIC's files write it) get every trigger frame as it is sent.
     this.withdraw = publish(ctx, "Stimulus", {
       targetWidth: T,
+      cues: this.cycle.N,
       onTrigger: (fn: (f: Frame) => void) => this.triggers.listen(fn),
       endCapture: (t: number) => this.endCapture(t),
     } satisfies StimulusTriggers);

@@ -16,6 +16,8 @@ import { StimulusRun } from "./stimulus-run";
  */
 export interface StimulusTriggers {
   readonly targetWidth: number;
+  /** Cues in the protocol (Tasks × Repetitions): one capture phase each, so one TAC trial each. */
+  readonly cues: number;
   /** Calls `fn` with every trigger frame (borrowed: copy what you keep) before it is emitted. */
   onTrigger(fn: (f: Frame) => void): () => void;
   /** Ends a capture phase in progress at time `t` (MOSAIC's TAC moved its Stimulus to fall). */

@@ -384,8 +384,10 @@ export class TacRun {
     );
   }
 
+  /** "trial k/N" when the number of trials is known (the Targets list, the Stimulus's cues). */
   private trialName(): string {
-    return this.total > 0 ? `trial ${this.k + 1}/${this.total}` : `trial ${this.k + 1}`;
+    const n = this.total > 0 ? this.total : (this.stim?.cues ?? 0);
+    return n > 0 ? `trial ${this.k + 1}/${n}` : `trial ${this.k + 1}`;
   }
 
   private actions(): Record<string, BlockAction> {

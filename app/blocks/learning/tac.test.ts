@@ -504,5 +504,10 @@ describe("TAC in a pipeline", () => {
     // Rest 2, rise 1, hold 2, capture (ended by the success after 2 s), fall 1: the second
     // capture starts 8 s after the first.
     expect(trials.t.map((t) => Math.round((t - 100) * 100) / 100)).toEqual([7, 15]);
+    // During the first capture (from 5 s), the status counts the trials from the Stimulus's cues.
+    const during = await runVirtualPipeline(yaml, { catalog: withCursor, duration: 6, start: 100 });
+    expect(during.telemetry.blocks.find((b) => b.name === "tac")!.text).toMatch(
+      /^trial 1\/2: inside 1\.0 s$/,
+    );
   });
 });

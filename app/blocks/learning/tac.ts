@@ -127,7 +127,7 @@ export const TAC = defineBlock({
     "starts and all NaN when it ends (for a display, or a Buffer). Time is the events' " +
     "timestamps (deterministic under the virtual clock); the test advances on control events, " +
     "so the control input must be periodic. Actions: `start` (a new test: clears the results), " +
-    "`stop` (the trial in progress is dropped), `summary`. The status shows the trial and the " +
+    "`stop` (the trial in progress is dropped), `summary`. The status shows the trial (k/N with Targets or a Stimulus: its cues) and the " +
     "time inside; when finished, the success rate, mean completion time and mean path " +
     "efficiency (over successful trials). MOSAIC's `[stimulusBlock, dwell, tolerance]` loads " +
     "with Order target-control, Autostart and `Stimulus`: as MOSAIC's TAC, it reads the named " +
