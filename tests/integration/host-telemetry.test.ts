@@ -46,3 +46,29 @@ test("the JSON line equals the merged objects, with blocks on two workers", asyn
   ]);
   expect(last.edges.length).toBe(2);
 }, 30_000);
+
+test("reports travel in groups; what waits is sent before the worker stops, in order", async () => {
+  requireBuild();
+  const dir = tempDir();
+  const file = join(dir, "one.yaml");
+  writeFileSync(
+    file,
+    "Timer: { Type: ScheduledTimer, DesiredRate: 200 }\n" +
+      "Emg: { Type: EmgSimulator, Inputs: [Timer], Params: { Channels: 2 } }\n",
+  );
+  const times: number[] = [];
+  // Groups of 10 s at 20 Hz (200 reports): nothing is sent while the pipeline runs for 1 s.
+  const { host } = await Host.load(
+    file,
+    { telemetryHz: 20, telemetryGroupS: 10 },
+    { telemetryLine: (line) => times.push((JSON.parse(line) as Telemetry).t) },
+  );
+  host!.start();
+  await new Promise((r) => setTimeout(r, 1000));
+  expect(times).toEqual([]);
+  await host!.stop();
+  // Every report of that second arrives at the stop, oldest first, each with its own time.
+  expect(times.length).toBeGreaterThanOrEqual(10);
+  expect(times.length).toBeLessThanOrEqual(25);
+  for (let i = 1; i < times.length; i++) expect(times[i]!).toBeGreaterThan(times[i - 1]!);
+}, 30_000);
