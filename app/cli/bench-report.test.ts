@@ -247,8 +247,20 @@ describe("bench report", () => {
     expect(md).toContain("| myo | 5 | 2 | 2.00 | 100 |");
     // Pairs: 5 − 3.5, 4 − 4.5, 3 − 2 (a pair may come out below 0 when the load drifts).
     expect(md).toContain(
-      "- myo, batching 5 ms: telemetry at 20 Hz instead of 2 Hz costs 1.50, -0.50, 1.00 % of one core in 3 pair(s) of runs (median 1.00 %)",
+      "- myo, batching 5 ms: telemetry at 20 Hz instead of 2 Hz costs 1.50, -0.50, 1.00 % of one core in 3 pair(s) of runs (mean 0.67 %, median 1.00 %)",
     );
+    // The sweep's order now: pairs alternate (20, 2), (2, 20), …; each pair reads 20 Hz − 2 Hz. A
+    // load falling by 0.5 % per run and a true cost of 1 %: the pairs read 1 ± 0.5, the mean 1.
+    const abba: BatchingResult = {
+      ...r,
+      telemetryHz: [20, 2, 2, 20, 20, 2, 2, 20],
+      rows: [20, 2, 2, 20, 20, 2, 2, 20].map((hz, i) => row(hz, 5 - 0.5 * i + (hz === 20 ? 1 : 0))),
+    };
+    expect(batchingMarkdown(abba).join("\n")).toContain(
+      "costs 1.50, 0.50, 1.50, 0.50 % of one core in 4 pair(s) of runs (mean 1.00 %, median 1.00 %)",
+    );
+    expect(batchingMarkdown(abba).join("\n")).toContain("cancels in the mean");
+    expect(md).toContain("every pair ran the higher rate first");
   });
 
   test("--only: an id selects that workload alone, a group name or NAME* the group", () => {

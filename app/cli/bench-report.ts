@@ -5,7 +5,7 @@
 import { failed, fmt, fmtRateSI, load, section, table } from "./bench-format";
 import { pipelineMarkdown } from "./bench-report-pipeline";
 import { soakMarkdown } from "./bench-soak";
-import { quantile } from "./bench-stats";
+import { mean, quantile } from "./bench-stats";
 import type {
   BatchingResult,
   BatchingRow,
@@ -99,9 +99,12 @@ export function batchingMarkdown(r: BatchingResult, heading = "##"): string[] {
 }
 
 /**
- * The telemetry sweep's reading: per pipeline and interval, the CPU median of each run at the
- * highest telemetry rate minus that of the run at the lowest right after it, and their median
- * (pairs taken one after the other, so that a drift of the machine's load falls on both).
+ * The telemetry sweep's reading: per pipeline and interval, the runs taken two by two in order
+ * (a pair is one run at the highest telemetry rate and one at the lowest, one right after the
+ * other, so that a drift of the machine's load falls on both), the CPU median at the highest
+ * minus that at the lowest in each pair, their mean and their median. The sweep alternates the
+ * order within pairs (20, 2, then 2, 20, …): a steady drift adds to one pair what it takes from
+ * the next, so it cancels in the mean over an even number of pairs.
  */
 function telemetryCost(r: BatchingResult): string[] {
   const rates = r.telemetryHz;
@@ -117,27 +120,35 @@ function telemetryCost(r: BatchingResult): string[] {
       lines.push(
         `- ${id}, batching ${ms} ms: telemetry at ${hi} Hz instead of ${lo} Hz costs ` +
           `${d.map((x) => fmt(x, 2)).join(", ")} % of one core in ${d.length} pair(s) of runs ` +
-          `(median ${fmt(quantile(d, 0.5), 2)} %)`,
+          `(mean ${fmt(mean(d), 2)} %, median ${fmt(quantile(d, 0.5), 2)} %)`,
       );
     }
   }
   if (lines.length === 0) return [];
-  return [
-    ...lines,
-    "",
+  const swing =
     "Single pairs swing with the machine's load (a 15-s run's median moves by a percent on a shared " +
-      "machine); the median of the pairs is the figure.",
-    "",
-  ];
+    "machine)";
+  // Results written before the order alternated have every pair high-then-low.
+  const alternating = rates.some((hz, i) => i % 2 === 0 && hz === lo && rates[i + 1] === hi);
+  const reading = alternating
+    ? ". The pairs alternate their order (the higher rate first, then the lower first), so a " +
+      "steady drift of the load cancels in the mean of an even number of pairs; the median resists " +
+      "one disturbed pair."
+    : "; the median of the pairs is the figure (every pair ran the higher rate first, so a drift " +
+      "of the load leans all of them the same way).";
+  return [...lines, "", swing + reading, ""];
 }
 
-/** CPU at `hi` minus CPU at `lo` for each run at `hi` directly followed by one at `lo`. */
+/**
+ * CPU at `hi` minus CPU at `lo` in each pair of consecutive runs (runs 1–2, 3–4, …) that holds one
+ * run at each rate, in either order.
+ */
 function pairDifferences(runs: BatchingRow[], hi: number, lo: number): number[] {
   const d: number[] = [];
-  for (let i = 0; i + 1 < runs.length; i++) {
-    const a = runs[i]!;
-    const b = runs[i + 1]!;
+  for (let i = 0; i + 1 < runs.length; i += 2) {
+    const [a, b] = [runs[i]!, runs[i + 1]!];
     if (a.telemetryHz === hi && b.telemetryHz === lo) d.push(a.cpuMedianPct - b.cpuMedianPct);
+    else if (a.telemetryHz === lo && b.telemetryHz === hi) d.push(b.cpuMedianPct - a.cpuMedianPct);
   }
   return d;
 }

@@ -222,7 +222,8 @@ export const WORKLOADS: WorkloadDef[] = [
       "Telemetry cost — the Myo pipeline at the default batching interval with telemetry at 20 Hz (the UI's rate, the CLI's default) and at 2 Hz, in turn: CPU",
     pipelines: ["myo"],
     intervalsMs: [5], // the default (DEFAULT_BATCHING_S, app/engine/runtime/runtime.ts)
-    telemetryHz: [20, 2, 20, 2, 20, 2],
+    // Pairs in alternating order (20 then 2, 2 then 20, …): a steady drift of the load cancels.
+    telemetryHz: [20, 2, 2, 20, 20, 2, 2, 20],
   },
   {
     kind: "soak",
