@@ -20,6 +20,7 @@ import type {
   BlePeripheral,
   BlockContext,
 } from "../../engine";
+import { ADAPTER_TEXT, addressKey, claimsOf, connectAttempt, errorText } from "../shared/ble";
 import { plural } from "../shared/text";
 import {
   decodeNilsPod,
@@ -42,24 +43,6 @@ export const NILSPOD_SCAN_RESTART = 5;
 const HEARTBEAT = 0.1;
 
 type Phase = "adapter" | "scanning" | "connecting" | "configuring" | "streaming" | "lost";
-
-const ADAPTER_TEXT: Record<Exclude<BleAdapterState, "poweredOn">, string> = {
-  unknown: "waiting for the Bluetooth adapter…",
-  resetting: "the Bluetooth adapter is resetting…",
-  unsupported: "the Bluetooth adapter does not support Bluetooth LE",
-  unauthorized: "not allowed to use the Bluetooth adapter",
-  poweredOff: "Bluetooth is off (switch it on; on Linux: bluetoothctl power on)",
-  unavailable: "no Bluetooth adapter",
-};
-
-/** NilsPods in use by a NilsPod block, per bridge: a block without Address skips them. */
-const claimed = new WeakMap<BleBridge, Set<string>>();
-const keyOf = (a: string): string => a.replace(/[:-]/g, "").toLowerCase();
-function claimsOf(b: BleBridge): Set<string> {
-  let s = claimed.get(b);
-  if (!s) claimed.set(b, (s = new Set()));
-  return s;
-}
 
 export interface NilsPodCounts {
   samples: number;
@@ -216,9 +199,9 @@ export class NilsPodLink {
   }
 
   private wanted(p: BlePeripheral): boolean {
-    if (this.o.address !== undefined) return keyOf(p.address) === keyOf(this.o.address);
+    if (this.o.address !== undefined) return addressKey(p.address) === addressKey(this.o.address);
     if (!(p.name ?? "").startsWith(NILSPOD_NAME_PREFIX)) return false;
-    return !claimsOf(this.bridge).has(keyOf(p.address));
+    return !claimsOf(this.bridge).has(addressKey(p.address));
   }
 
   private onFound(p: BlePeripheral): void {
@@ -231,28 +214,24 @@ export class NilsPodLink {
     const g = ++this.gen;
     this.address = p.address;
     this.name = p.name ?? "";
-    claimsOf(this.bridge).add(keyOf(p.address));
+    claimsOf(this.bridge).add(addressKey(p.address));
     this.phase = "connecting";
     this.describe();
-    let c: BleConnection;
-    try {
-      c = await this.bridge.connect(p.address, (reason) => this.onLost(g, reason));
-    } catch (e) {
-      if (g === this.gen) this.fail(`connection failed: ${errorText(e)}`);
-      return;
-    }
-    if (g !== this.gen) {
-      c.disconnect();
-      return;
-    }
-    this.conn = c;
-    this.phase = "configuring";
-    this.describe();
-    try {
-      await this.setUp(c, g);
-    } catch (e) {
-      if (g === this.gen) this.fail(`setting up failed: ${errorText(e)}`);
-    }
+    await connectAttempt(this.bridge, p.address, {
+      onLost: (reason) => this.onLost(g, reason),
+      current: () => g === this.gen,
+      fail: (reason) => this.fail(reason),
+      connected: async (c) => {
+        this.conn = c;
+        this.phase = "configuring";
+        this.describe();
+        try {
+          await this.setUp(c, g);
+        } catch (e) {
+          if (g === this.gen) this.fail(`setting up failed: ${errorText(e)}`);
+        }
+      },
+    });
   }
 
   /** Discover, subscribe to the samples, then start streaming (the original's order). */
@@ -344,7 +323,7 @@ export class NilsPodLink {
   }
 
   private release(): void {
-    if (this.address !== undefined) claimsOf(this.bridge).delete(keyOf(this.address));
+    if (this.address !== undefined) claimsOf(this.bridge).delete(addressKey(this.address));
   }
 
   private who(): string {
@@ -407,7 +386,6 @@ export class NilsPodLink {
 }
 
 const norm = (u: string): string => u.replace(/-/g, "").toLowerCase();
-const errorText = (e: unknown): string => (e as Error)?.message ?? String(e);
 
 export interface NilsPodLinkParams {
   Address?: string | undefined;

@@ -15,6 +15,7 @@ import type {
   Frame,
   OutputPort,
 } from "../../engine";
+import { ADAPTER_TEXT, addressKey, claimsOf, connectAttempt, errorText } from "../shared/ble";
 import { plural, TextThrottle } from "../shared/text";
 import {
   decodeEmg,
@@ -50,26 +51,6 @@ type Phase =
   | "streaming"
   | "lost"
   | "stopped";
-
-/** Armbands in use by a Myo block, per bridge: a block without Address skips them. */
-const claimed = new WeakMap<BleBridge, Set<string>>();
-const claimsOf = (b: BleBridge): Set<string> => {
-  let s = claimed.get(b);
-  if (!s) claimed.set(b, (s = new Set()));
-  return s;
-};
-const addressKey = (a: string): string => a.replace(/[:-]/g, "").toLowerCase();
-
-const ADAPTER_TEXT: Record<Exclude<BleAdapterState, "poweredOn">, string> = {
-  unknown: "waiting for the Bluetooth adapter…",
-  resetting: "the Bluetooth adapter is resetting…",
-  unsupported: "the Bluetooth adapter does not support Bluetooth LE",
-  unauthorized: "not allowed to use the Bluetooth adapter",
-  poweredOff: "Bluetooth is off (switch it on; on Linux: bluetoothctl power on)",
-  unavailable: "no Bluetooth adapter",
-};
-
-const errorText = (e: unknown): string => (e as Error)?.message ?? String(e);
 
 /** "service/characteristic" keys of what a connection's discovery found. */
 function characteristicKeys(found: readonly { service: string; uuid: string }[]): Set<string> {
@@ -306,26 +287,22 @@ export class MyoRun {
     claimsOf(b).add(addressKey(to));
     this.phase = "connecting";
     this.refresh();
-    let c: BleConnection;
-    try {
-      c = await b.connect(to, (reason) => {
+    await connectAttempt(b, to, {
+      onLost: (reason) => {
         if (g !== this.gen) return;
         this.conn = undefined;
         this.disconnections++;
         this.fail(`disconnected (${reason})`);
-      });
-    } catch (e) {
-      if (g === this.gen) this.fail(`connection failed: ${errorText(e)}`);
-      return;
-    }
-    if (g !== this.gen) {
-      c.disconnect();
-      return;
-    }
-    this.conn = c;
-    this.phase = "configuring";
-    this.refresh();
-    await this.configure(c, g);
+      },
+      current: () => g === this.gen,
+      fail: (reason) => this.fail(reason),
+      connected: async (c) => {
+        this.conn = c;
+        this.phase = "configuring";
+        this.refresh();
+        await this.configure(c, g);
+      },
+    });
   }
 
   /** Checks the armband's characteristics, subscribes, and starts it streaming. */
