@@ -8,11 +8,14 @@ import {
   legacyPair,
   LegacyParamsError,
   legacyVector,
+  type BlockContext,
+  type Frame,
+  type OutputPort,
   type Shape,
 } from "../../engine";
 import { FunctionKernel, type FunctionOperation } from "../../engine/dsp";
 import { requireDsp } from "../shared/dsp";
-import { inputName, signalInput } from "../shared/inputs";
+import { inputName, signalInput, type SignalInput } from "../shared/inputs";
 import { extendedNumber } from "../shared/params";
 import { MAX_CHANNELS } from "../shared/limits";
 
@@ -60,14 +63,152 @@ function expandOperand(values: readonly number[], shape: Shape, into: Float64Arr
   else for (let k = 0; k < size; k++) into[k] = values[k % shape.cols]!;
 }
 
+/** Whether an operand of `len` values fits the shape: 1, one per column or one per element. */
 function operandFits(len: number, shape: Shape): boolean {
   return len === 1 || len === shape.cols || len === shape.rows * shape.cols;
 }
 
+/** The operand widths that fit the shape, as messages write them. */
 function expectedWidths(shape: Shape): string {
   return shape.rows === 1
     ? `1 or ${shape.cols}`
     : `1, ${shape.cols} (one per column) or ${shape.rows * shape.cols} (one per element)`;
+}
+
+/** Shared by every kernel of one instance: the operation, the signal input, the operand source. */
+interface Setup {
+  op: FunctionOperation;
+  sig: SignalInput;
+  /** A second input gives the operand (then Value is not used). */
+  withInput: boolean;
+}
+
+/** add and multiply take an operand; abs, power and clip do not. */
+function takesOperand(op: FunctionOperation): boolean {
+  return op === "add" || op === "multiply";
+}
+
+/** Checks where the operand comes from (Value or a second input); the operand input's shape. */
+function checkOperandSource(ctx: BlockContext, p: Params, sig: SignalInput): Shape | null {
+  const op = p.Operation;
+  if (ctx.inputs.length === 2) {
+    if (!takesOperand(op)) {
+      throw new BlockConfigError(
+        `a second input (${inputName(ctx.inputs[1]!)}) is only used by add and multiply, not ` +
+          `by ${op}; remove it`,
+        "Operation",
+      );
+    }
+    if (p.Value !== undefined) {
+      throw new BlockConfigError(
+        `Value is set, but the second input ${inputName(ctx.inputs[1]!)} provides the operand; ` +
+          "remove one of them",
+        "Value",
+      );
+    }
+    const o = signalInput(ctx, 1);
+    if (o.shape.rows !== 1 || !operandFits(o.size, sig.shape)) {
+      throw new BlockConfigError(
+        `the operand input ${inputName(o.info)} has shape [${o.shape.rows}, ${o.shape.cols}]; ` +
+          `expected a vector of width ${expectedWidths(sig.shape)} to match input ${inputName(sig.info)}`,
+      );
+    }
+    return o.shape;
+  }
+  if (takesOperand(op) && p.Value === undefined) {
+    throw new BlockConfigError(
+      `${op} needs Value (a number, or one per channel) or a second input giving the operand`,
+      "Value",
+    );
+  }
+  return null;
+}
+
+/** Value as a list of numbers, refused unless its length fits the signal's shape. */
+function checkValue(v: number | number[] | undefined, sig: SignalInput): number[] | undefined {
+  if (v === undefined) return undefined;
+  const shape = sig.shape;
+  const list = typeof v === "number" ? [v] : v;
+  if (!operandFits(list.length, shape)) {
+    throw new BlockConfigError(
+      `Value has ${list.length} numbers, but input ${inputName(sig.info)} has shape ` +
+        `[${shape.rows}, ${shape.cols}]; expected ${expectedWidths(shape)} numbers`,
+      "Value",
+    );
+  }
+  return list;
+}
+
+/** The kernel's operand: the identity with an operand input, else Value (1 or per element). */
+function kernelOperand(setup: Setup, q: Params): number[] | undefined {
+  if (!takesOperand(setup.op)) return undefined;
+  if (setup.withInput) return [setup.op === "add" ? 0 : 1];
+  const { shape, size } = setup.sig;
+  const list = checkValue(q.Value, setup.sig)!;
+  if (list.length === 1 || list.length === size) return list;
+  const full = new Float64Array(size);
+  expandOperand(list, shape, full);
+  return Array.from(full);
+}
+
+/** A kernel for these params; its failure is a BlockConfigError naming the operation. */
+function buildKernel(setup: Setup, q: Params): FunctionKernel {
+  const operand = kernelOperand(setup, q);
+  try {
+    return new FunctionKernel(
+      setup.op,
+      {
+        ...(operand !== undefined ? { operand } : {}),
+        exponent: q.Exponent,
+        ...(q.Min !== undefined ? { min: q.Min } : {}),
+        ...(q.Max !== undefined ? { max: q.Max } : {}),
+      },
+      setup.sig.size,
+    );
+  } catch (e) {
+    throw new BlockConfigError(`cannot create the ${setup.op} kernel: ${errorMessage(e)}`);
+  }
+}
+
+/** The params after a live change of `name`; refused if Value is unused or misfits or Min > Max. */
+function checkedChange(setup: Setup, current: Params, name: string, value: unknown): Params {
+  const next: Params = { ...current, [name]: value };
+  if (name === "Value") {
+    if (setup.withInput) {
+      throw new Error("Value is not used while a second input provides the operand");
+    }
+    checkValue(next.Value, setup.sig);
+  }
+  if (next.Min !== undefined && next.Max !== undefined && next.Min > next.Max) {
+    throw new Error(`Min ${next.Min} would be greater than Max ${next.Max}`);
+  }
+  return next;
+}
+
+/** Keeps the latest operand event (of `oCols` values), expanded to one value per element. */
+function takeLatestOperand(f: Frame, oCols: number, operand: Float64Array): void {
+  const size = operand.length;
+  const last = (f.n - 1) * oCols;
+  const v = f.v;
+  if (oCols === 1) operand.fill(v[last]!);
+  else if (oCols === size) for (let k = 0; k < size; k++) operand[k] = v[last + k]!;
+  else for (let k = 0; k < size; k++) operand[k] = v[last + (k % oCols)]!;
+}
+
+/** Applies the kernel to a signal frame (with the operand input's values, if any) and emits it. */
+function emitApplied(
+  f: Frame,
+  kernel: FunctionKernel,
+  operand: Float64Array | null,
+  out: OutputPort,
+): void {
+  const n = f.n;
+  const o = out.frame(n);
+  const ft = f.t;
+  for (let e = 0; e < n; e++) o.t[e] = ft[e]!;
+  if (operand !== null) kernel.processWithOperand(f.v, operand, o.v, n);
+  else kernel.process(f.v, o.v, n);
+  out.emit(o);
 }
 
 export const FunctionBlock = defineBlock({
@@ -127,127 +268,27 @@ export const FunctionBlock = defineBlock({
   create(ctx, p) {
     requireDsp(ctx.type);
     const sig = signalInput(ctx, 0);
-    const shape = sig.shape;
-    const size = sig.size;
-    const op: FunctionOperation = p.Operation;
-    const takesOperand = op === "add" || op === "multiply";
-    const withInput = ctx.inputs.length === 2;
-    let operandShape: Shape | null = null;
-    if (withInput) {
-      if (!takesOperand) {
-        throw new BlockConfigError(
-          `a second input (${inputName(ctx.inputs[1]!)}) is only used by add and multiply, not ` +
-            `by ${op}; remove it`,
-          "Operation",
-        );
-      }
-      if (p.Value !== undefined) {
-        throw new BlockConfigError(
-          `Value is set, but the second input ${inputName(ctx.inputs[1]!)} provides the operand; ` +
-            "remove one of them",
-          "Value",
-        );
-      }
-      const o = signalInput(ctx, 1);
-      if (o.shape.rows !== 1 || !operandFits(o.size, shape)) {
-        throw new BlockConfigError(
-          `the operand input ${inputName(o.info)} has shape [${o.shape.rows}, ${o.shape.cols}]; ` +
-            `expected a vector of width ${expectedWidths(shape)} to match input ${inputName(sig.info)}`,
-        );
-      }
-      operandShape = o.shape;
-    } else if (takesOperand && p.Value === undefined) {
-      throw new BlockConfigError(
-        `${op} needs Value (a number, or one per channel) or a second input giving the operand`,
-        "Value",
-      );
-    }
-
-    const checkValue = (v: number | number[] | undefined): number[] | undefined => {
-      if (v === undefined) return undefined;
-      const list = typeof v === "number" ? [v] : v;
-      if (!operandFits(list.length, shape)) {
-        throw new BlockConfigError(
-          `Value has ${list.length} numbers, but input ${inputName(sig.info)} has shape ` +
-            `[${shape.rows}, ${shape.cols}]; expected ${expectedWidths(shape)} numbers`,
-          "Value",
-        );
-      }
-      return list;
-    };
-
-    const build = (q: Params): FunctionKernel => {
-      let operand: number[] | undefined;
-      if (takesOperand) {
-        if (withInput) operand = [op === "add" ? 0 : 1];
-        else {
-          const list = checkValue(q.Value)!;
-          if (list.length === 1 || list.length === size) operand = list;
-          else {
-            const full = new Float64Array(size);
-            expandOperand(list, shape, full);
-            operand = Array.from(full);
-          }
-        }
-      }
-      try {
-        return new FunctionKernel(
-          op,
-          {
-            ...(operand !== undefined ? { operand } : {}),
-            exponent: q.Exponent,
-            ...(q.Min !== undefined ? { min: q.Min } : {}),
-            ...(q.Max !== undefined ? { max: q.Max } : {}),
-          },
-          size,
-        );
-      } catch (e) {
-        throw new BlockConfigError(`cannot create the ${op} kernel: ${errorMessage(e)}`);
-      }
-    };
-
+    const operandShape = checkOperandSource(ctx, p, sig);
+    const setup: Setup = { op: p.Operation, sig, withInput: operandShape !== null };
     const current: Params = { ...p };
-    let kernel = build(current);
-    const identity = op === "add" ? 0 : 1;
-    const operand = new Float64Array(size).fill(identity);
-    const out = ctx.output(shape);
+    let kernel = buildKernel(setup, current);
+    const identity = p.Operation === "add" ? 0 : 1;
+    const operand = new Float64Array(sig.size).fill(identity);
+    const out = ctx.output(sig.shape);
     const oCols = operandShape?.cols ?? 0;
 
     return {
       process(f, port) {
-        const n = f.n;
-        if (n === 0) return;
-        if (port === 1) {
-          // The latest operand value, expanded to one value per element.
-          const last = (n - 1) * oCols;
-          const v = f.v;
-          if (oCols === 1) operand.fill(v[last]!);
-          else if (oCols === size) for (let k = 0; k < size; k++) operand[k] = v[last + k]!;
-          else for (let k = 0; k < size; k++) operand[k] = v[last + (k % oCols)]!;
-          return;
-        }
-        const o = out.frame(n);
-        const ft = f.t;
-        for (let e = 0; e < n; e++) o.t[e] = ft[e]!;
-        if (withInput) kernel.processWithOperand(f.v, operand, o.v, n);
-        else kernel.process(f.v, o.v, n);
-        out.emit(o);
+        if (f.n === 0) return;
+        if (port === 1) takeLatestOperand(f, oCols, operand);
+        else emitApplied(f, kernel, setup.withInput ? operand : null, out);
       },
       reset() {
         operand.fill(identity);
       },
       setParam(name, value) {
-        const next: Params = { ...current, [name]: value };
-        if (name === "Value") {
-          if (withInput) {
-            throw new Error("Value is not used while a second input provides the operand");
-          }
-          checkValue(next.Value);
-        }
-        if (next.Min !== undefined && next.Max !== undefined && next.Min > next.Max) {
-          throw new Error(`Min ${next.Min} would be greater than Max ${next.Max}`);
-        }
-        const k = build(next);
+        const next = checkedChange(setup, current, name, value);
+        const k = buildKernel(setup, next);
         kernel.dispose();
         kernel = k;
         Object.assign(current, next);
