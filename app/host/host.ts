@@ -17,13 +17,14 @@ import { serialHub } from "../../native-bridges/serial-proxy";
 import { bleHub } from "../../native-bridges/ble-proxy";
 import type { BleBridge } from "../engine/io";
 import { LogWriter } from "./log-writer";
-import { takeTimeBase } from "./time-base";
+import { takeTimeBase, type TimeBase } from "./time-base";
 import { telemetryGroup } from "./telemetry-outbox";
 import {
   DEFAULT_TELEMETRY_HZ,
   type ClockMode,
   type ControlOp,
   type HostToWorker,
+  type InitMessage,
   type TelemetryReport,
   type WorkerToHost,
 } from "./worker-protocol";
@@ -143,6 +144,48 @@ export interface LoadOutcome {
   diagnostics: Diagnostic[];
 }
 
+/** What every worker's init message carries besides the options: the file, its text, the clock. */
+interface Boot {
+  full: string;
+  source: string;
+  timeBase: TimeBase;
+}
+
+/** The pipeline file's text, or the diagnostic that says why it cannot be read. */
+function readSource(file: string, full: string): string | Diagnostic {
+  try {
+    return readFileSync(full, "utf8");
+  } catch (e) {
+    const code = (e as NodeJS.ErrnoException).code;
+    return {
+      severity: "error",
+      code: "file",
+      message: code === "ENOENT" ? "no such file" : `cannot read the file: ${errorMessage(e)}`,
+      file,
+      line: 0,
+      col: 0,
+    };
+  }
+}
+
+/** The host's options with every default filled in (`full`: the pipeline file's path). */
+function hostDefaults(full: string, opts: HostOptions): Host["options"] {
+  return {
+    mode: opts.mode ?? "realtime",
+    precision: opts.precision ?? false,
+    logDir: opts.logDir ?? dirname(full),
+    virtualStart: opts.virtualStart ?? 0,
+    virtualDuration: opts.virtualDuration ?? Infinity,
+    telemetryHz: opts.telemetryHz ?? DEFAULT_TELEMETRY_HZ,
+    telemetryGroupS: opts.telemetryGroupS ?? 0.25,
+    batchingS: opts.batchingS,
+    simulateDevices: opts.simulateDevices,
+    ble: opts.ble,
+    workerPath: opts.workerPath ?? defaultWorkerPath(),
+    wasmPath: opts.wasmPath ?? defaultWasmPath(),
+  };
+}
+
 export class Host {
   private readonly workers = new Map<string, WorkerState>();
   private readonly logWriter: LogWriter;
@@ -175,108 +218,33 @@ export class Host {
     );
   }
 
-  /** Loads and instantiates a pipeline file; on failure returns its diagnostics and no host. */
+  /**
+   * Loads and instantiates a pipeline file; on failure returns its diagnostics and no host. The
+   * main thread does not load the catalog: the main worker parses, validates and plans; the other
+   * workers (`Worker:` names) then instantiate their blocks from that plan, and the host links them.
+   */
   static async load(
     file: string,
     opts: HostOptions = {},
     events: HostEvents = {},
   ): Promise<LoadOutcome> {
     const full = resolve(file);
-    let source: string;
-    try {
-      source = readFileSync(full, "utf8");
-    } catch (e) {
-      const code = (e as NodeJS.ErrnoException).code;
-      return {
-        host: undefined,
-        diagnostics: [
-          {
-            severity: "error",
-            code: "file",
-            message:
-              code === "ENOENT" ? "no such file" : `cannot read the file: ${errorMessage(e)}`,
-            file,
-            line: 0,
-            col: 0,
-          },
-        ],
-      };
-    }
-    // The main thread does not load the catalog: the main worker parses, validates and plans.
-    const mode = opts.mode ?? "realtime";
-    const host = new Host(file, {
-      mode,
-      precision: opts.precision ?? false,
-      logDir: opts.logDir ?? dirname(full),
-      virtualStart: opts.virtualStart ?? 0,
-      virtualDuration: opts.virtualDuration ?? Infinity,
-      telemetryHz: opts.telemetryHz ?? DEFAULT_TELEMETRY_HZ,
-      telemetryGroupS: opts.telemetryGroupS ?? 0.25,
-      batchingS: opts.batchingS,
-      simulateDevices: opts.simulateDevices,
-      ble: opts.ble,
-      workerPath: opts.workerPath ?? defaultWorkerPath(),
-      wasmPath: opts.wasmPath ?? defaultWasmPath(),
-    });
+    const source = readSource(file, full);
+    if (typeof source !== "string") return { host: undefined, diagnostics: [source] };
+    const host = new Host(file, hostDefaults(full, opts));
     host.events = events;
-    const timeBase = takeTimeBase();
-    const diagnostics: Diagnostic[] = [];
-    const init = (name: string, plan?: Plan) => ({
-      type: "init" as const,
-      file: full,
-      source,
-      worker: name,
-      mode,
-      timeBase,
-      virtualStart: host.options.virtualStart,
-      virtualDuration: host.options.virtualDuration,
-      wasmPath: host.options.wasmPath,
-      ...(plan ? { plan } : {}),
-      precision: host.options.precision,
-      telemetryHz: host.options.telemetryHz,
-      telemetryGroup: telemetryGroup(host.options.telemetryGroupS, host.options.telemetryHz),
-      ...(host.options.batchingS !== undefined ? { batchingS: host.options.batchingS } : {}),
-      ...(host.options.simulateDevices ? { simulateDevices: host.options.simulateDevices } : {}),
-    });
+    const boot: Boot = { full, source, timeBase: takeTimeBase() };
     // The main worker instantiates everything once to learn shapes and rates (the plan).
-    const main = host.spawn("main");
-    const first = await host.request(
-      main,
-      init("main"),
-      (m) => m.type === "created" || m.type === "failed" || m.type === "fatal",
-    );
-    const fail = async (d: Diagnostic[]) => {
-      await host.terminateAll();
-      return { host: undefined, diagnostics: [...diagnostics, ...d] };
-    };
-    if (first.type === "fatal")
-      return fail([
-        { severity: "error", code: "fatal", message: first.message, file, line: 0, col: 0 },
-      ]);
-    if (first.type !== "created") return fail(first.type === "failed" ? first.diagnostics : []);
-    diagnostics.push(...first.diagnostics);
-    main.doorbell = first.doorbell;
-    host.plan = first.plan;
-    const names =
-      mode === "virtual"
-        ? ["main"]
-        : ["main", ...new Set(first.plan.blocks.map((b) => b.worker).filter((w) => w !== "main"))];
-    for (const name of names.slice(1)) {
-      const w = host.spawn(name);
-      const r = await host.request(
-        w,
-        init(name, first.plan),
-        (m) => m.type === "created" || m.type === "failed" || m.type === "fatal",
-      );
-      if (r.type === "fatal")
-        return fail([
-          { severity: "error", code: "fatal", message: r.message, file, line: 0, col: 0 },
-        ]);
-      if (r.type !== "created") return fail(r.type === "failed" ? r.diagnostics : []);
-      w.doorbell = r.doorbell;
+    const main = await host.createWorker("main", boot);
+    if (!main.ok) return host.failed(main.diagnostics);
+    const { plan, diagnostics } = main;
+    host.plan = plan;
+    for (const name of host.otherWorkers(plan)) {
+      const w = await host.createWorker(name, boot, plan);
+      if (!w.ok) return host.failed([...diagnostics, ...w.diagnostics]);
     }
     host.linkWorkers(
-      first.plan.blocks.map((b) => ({
+      plan.blocks.map((b) => ({
         name: b.name,
         worker: b.worker,
         inputs: b.inputs,
@@ -284,6 +252,75 @@ export class Host {
       })),
     );
     return { host, diagnostics };
+  }
+
+  /**
+   * Starts a worker and has it instantiate its blocks (all of them for "main", which makes the
+   * plan; the planned ones otherwise): the plan and the loader's diagnostics, or why it failed.
+   */
+  private async createWorker(
+    name: string,
+    boot: Boot,
+    plan?: Plan,
+  ): Promise<
+    { ok: true; plan: Plan; diagnostics: Diagnostic[] } | { ok: false; diagnostics: Diagnostic[] }
+  > {
+    const w = this.spawn(name);
+    const r = await this.request(
+      w,
+      this.initMessage(name, boot, plan),
+      (m) => m.type === "created" || m.type === "failed" || m.type === "fatal",
+    );
+    if (r.type === "created") {
+      w.doorbell = r.doorbell;
+      return { ok: true, plan: r.plan, diagnostics: r.diagnostics };
+    }
+    if (r.type === "fatal") {
+      const d: Diagnostic = {
+        severity: "error",
+        code: "fatal",
+        message: r.message,
+        file: this.file,
+        line: 0,
+        col: 0,
+      };
+      return { ok: false, diagnostics: [d] };
+    }
+    return { ok: false, diagnostics: r.type === "failed" ? r.diagnostics : [] };
+  }
+
+  /** The init message for a worker (`plan`: the main worker's, for the others). */
+  private initMessage(name: string, boot: Boot, plan?: Plan): InitMessage {
+    const o = this.options;
+    return {
+      type: "init",
+      file: boot.full,
+      source: boot.source,
+      worker: name,
+      mode: o.mode,
+      timeBase: boot.timeBase,
+      virtualStart: o.virtualStart,
+      virtualDuration: o.virtualDuration,
+      wasmPath: o.wasmPath,
+      ...(plan ? { plan } : {}),
+      precision: o.precision,
+      telemetryHz: o.telemetryHz,
+      telemetryGroup: telemetryGroup(o.telemetryGroupS, o.telemetryHz),
+      ...(o.batchingS !== undefined ? { batchingS: o.batchingS } : {}),
+      ...(o.simulateDevices ? { simulateDevices: o.simulateDevices } : {}),
+    };
+  }
+
+  /** The workers besides "main" that the plan places blocks on (none on the virtual clock). */
+  private otherWorkers(plan: Plan): string[] {
+    if (this.options.mode === "virtual") return [];
+    return [...new Set(plan.blocks.map((b) => b.worker).filter((w) => w !== "main"))];
+  }
+
+  /** Loading failed: every worker started so far is ended; the diagnostics say why. */
+  private async failed(diagnostics: Diagnostic[]): Promise<LoadOutcome> {
+    await this.terminateAll();
+    return { host: undefined, diagnostics };
   }
 
   private spawn(name: string): WorkerState {
