@@ -5,6 +5,11 @@ import {
   LegacyParamsError,
   legacyInteger,
   vectorShape,
+  type BlockContext,
+  type BlockInstance,
+  type Frame,
+  type OutputPort,
+  type UdpBridge,
   type UdpSocketHandle,
 } from "../../engine";
 import {
@@ -33,6 +38,30 @@ const params = z.strictObject({
         "values to send as they are); auto: 11 values actuation, 12–15 prediction, 9 command",
     ),
 });
+
+/** What the input carries (kind undefined: the nine command values as they are) and its width. */
+interface Control {
+  kind: ControlKind | undefined;
+  size: number;
+}
+
+/** Checks input 0 against the Input param: a command has the nine values, else a control input. */
+function checkControl(ctx: BlockContext, input: z.infer<typeof params>["Input"]): Control {
+  if (input === "command") {
+    const s = vectorInput(ctx, 0, "Input");
+    if (s.size !== BLENDER_SIZE) {
+      throw new BlockConfigError(
+        `Input is command, but input ${inputName(s.info)} has ${s.size} values; a command has ${BLENDER_SIZE}`,
+        "Input",
+      );
+    }
+    return { kind: undefined, size: s.size };
+  }
+  return controlInput(ctx, 0, input, "Input", {
+    width: BLENDER_SIZE,
+    what: `the ${BLENDER_SIZE} command values`,
+  });
+}
 
 export const BlenderArm = defineBlock({
   type: "BlenderArm",
@@ -73,111 +102,142 @@ export const BlenderArm = defineBlock({
   views: ["spider", "label"],
   panel: "The nine values sent (spider), the destination and the datagrams sent.",
   create(ctx, p) {
-    let control: { kind: ControlKind | undefined; size: number };
-    if (p.Input === "command") {
-      const s = vectorInput(ctx, 0, "Input");
-      if (s.size !== BLENDER_SIZE) {
-        throw new BlockConfigError(
-          `Input is command, but input ${inputName(s.info)} has ${s.size} values; a command has ${BLENDER_SIZE}`,
-          "Input",
-        );
-      }
-      control = { kind: undefined, size: s.size };
-    } else {
-      control = controlInput(ctx, 0, p.Input, "Input", {
-        width: BLENDER_SIZE,
-        what: `the ${BLENDER_SIZE} command values`,
-      });
-    }
+    const control = checkControl(ctx, p.Input);
     // Aperiodic (MOSAIC set its rate to 0); it sends what arrives.
     if (ctx.declaredRate === undefined) ctx.setDesiredRate(0);
     const out = ctx.output(vectorShape(BLENDER_SIZE), "command");
-    const dest = endpointText(p.Host, p.Port);
-    const act = new Float64Array(ACTUATION_SIZE);
-    const cmd = new Float64Array(BLENDER_SIZE);
-    const warns = new WarnLimiter(ctx);
-    const throttle = new TextThrottle();
-    const reads = describeControl(control);
-
-    let socket: UdpSocketHandle | undefined;
-    let sent = 0;
-    let failed = 0;
-    let notSent = 0;
-    let lastError = "";
-    const bridge = udpBridge(ctx);
-    const describe = (): void => {
-      if (!bridge) {
-        ctx.setText(`${NO_UDP}: ${plural(notSent, "command")} not sent`);
-        return;
-      }
-      const err = failed > 0 ? `, ${failed} failed (${lastError})` : "";
-      ctx.setText(`→ ${dest}, ${reads}: ${plural(sent, "datagram")} sent${err}`);
-    };
-    if (bridge) describe();
-    const onError = (message: string): void => {
-      failed++;
-      lastError = message;
-      warns.warn(`UDP to ${dest}: ${message}`);
-      describe();
-    };
-    const close = (): void => {
-      const s = socket;
-      socket = undefined;
-      s?.close();
-    };
-
-    return {
-      start() {
-        if (!bridge) {
-          ctx.warn(`${NO_UDP}: the Blender arm gets nothing`);
-          return;
-        }
-        if (socket) return;
-        try {
-          socket = bridge.open({ remote: { host: p.Host, port: p.Port }, onError });
-        } catch (e) {
-          onError(e instanceof Error ? e.message : String(e));
-        }
-      },
-      process(f) {
-        const n = f.n;
-        if (n === 0) return;
-        const o = out.frame(n);
-        const v = f.v;
-        for (let e = 0; e < n; e++) {
-          o.t[e] = f.t[e]!;
-          if (control.kind === undefined) {
-            for (let k = 0; k < BLENDER_SIZE; k++) cmd[k] = v[e * BLENDER_SIZE + k]!;
-          } else {
-            toActuation(control, v, e, act);
-            blenderCommand(act, cmd);
-          }
-          o.v.set(cmd, e * BLENDER_SIZE);
-          const s = socket;
-          if (s) {
-            s.send(asciiBytes(blenderText(cmd)));
-            sent++;
-          } else notSent++;
-        }
-        out.emit(o);
-        if (throttle.due(f.t[n - 1]!)) describe();
-      },
-      stop() {
-        close();
-        describe();
-      },
-      reset() {
-        sent = 0;
-        failed = 0;
-        notSent = 0;
-        lastError = "";
-        throttle.reset();
-        warns.reset();
-        describe();
-      },
-      dispose() {
-        close();
-      },
-    };
+    return new BlenderArmRun(ctx, p.Host, p.Port, control, out).instance();
   },
 });
+
+/** One BlenderArm at run time: the socket, one datagram per event, the counts and the status. */
+class BlenderArmRun {
+  private socket: UdpSocketHandle | undefined;
+  private sent = 0;
+  private failed = 0;
+  private notSent = 0;
+  private lastError = "";
+  private readonly dest: string;
+  private readonly act = new Float64Array(ACTUATION_SIZE);
+  private readonly cmd = new Float64Array(BLENDER_SIZE);
+  private readonly warns: WarnLimiter;
+  private readonly throttle = new TextThrottle();
+  private readonly reads: string;
+  /** Undefined: UDP is unavailable here (udpBridge has said so in the status). */
+  private readonly bridge: UdpBridge | undefined;
+
+  constructor(
+    private readonly ctx: BlockContext,
+    private readonly host: string,
+    private readonly port: number,
+    private readonly control: Control,
+    private readonly out: OutputPort,
+  ) {
+    this.dest = endpointText(host, port);
+    this.warns = new WarnLimiter(ctx);
+    this.reads = describeControl(control);
+    this.bridge = udpBridge(ctx);
+    if (this.bridge) this.describe();
+  }
+
+  /** The block instance the engine drives. */
+  instance(): BlockInstance {
+    return {
+      start: () => this.start(),
+      process: (f) => this.process(f),
+      stop: () => {
+        this.close();
+        this.describe();
+      },
+      reset: () => this.reset(),
+      dispose: () => this.close(),
+    };
+  }
+
+  /** Opens the socket (once), or warns that without UDP the arm gets nothing. */
+  private start(): void {
+    if (!this.bridge) {
+      this.ctx.warn(`${NO_UDP}: the Blender arm gets nothing`);
+      return;
+    }
+    if (this.socket) return;
+    try {
+      this.socket = this.bridge.open({
+        remote: { host: this.host, port: this.port },
+        onError: this.onError,
+      });
+    } catch (e) {
+      this.onError(e instanceof Error ? e.message : String(e));
+    }
+  }
+
+  /** Emits each event's command on `command` and sends it; the status at the throttle's pace. */
+  private process(f: Frame): void {
+    const n = f.n;
+    if (n === 0) return;
+    const o = this.out.frame(n);
+    for (let e = 0; e < n; e++) {
+      o.t[e] = f.t[e]!;
+      this.commandAt(f.v, e);
+      o.v.set(this.cmd, e * BLENDER_SIZE);
+      this.send();
+    }
+    this.out.emit(o);
+    if (this.throttle.due(f.t[n - 1]!)) this.describe();
+  }
+
+  /** Fills `cmd` with event e's nine values: as they are, or mapped from actuation/predictions. */
+  private commandAt(v: Float64Array, e: number): void {
+    if (this.control.kind === undefined) {
+      for (let k = 0; k < BLENDER_SIZE; k++) this.cmd[k] = v[e * BLENDER_SIZE + k]!;
+    } else {
+      toActuation(this.control, v, e, this.act);
+      blenderCommand(this.act, this.cmd);
+    }
+  }
+
+  /** Sends `cmd` as one ASCII datagram, or counts it as not sent when there is no socket. */
+  private send(): void {
+    const s = this.socket;
+    if (s) {
+      s.send(asciiBytes(blenderText(this.cmd)));
+      this.sent++;
+    } else this.notSent++;
+  }
+
+  /** Counts a failed send or open, warns (rate-limited) and shows it. */
+  private readonly onError = (message: string): void => {
+    this.failed++;
+    this.lastError = message;
+    this.warns.warn(`UDP to ${this.dest}: ${message}`);
+    this.describe();
+  };
+
+  /** Zeroes the counts, the status throttle and the warning limiter, and shows the status. */
+  private reset(): void {
+    this.sent = 0;
+    this.failed = 0;
+    this.notSent = 0;
+    this.lastError = "";
+    this.throttle.reset();
+    this.warns.reset();
+    this.describe();
+  }
+
+  /** The status: the destination, what the input carries, datagrams sent and failed. */
+  private describe(): void {
+    if (!this.bridge) {
+      this.ctx.setText(`${NO_UDP}: ${plural(this.notSent, "command")} not sent`);
+      return;
+    }
+    const err = this.failed > 0 ? `, ${this.failed} failed (${this.lastError})` : "";
+    this.ctx.setText(`→ ${this.dest}, ${this.reads}: ${plural(this.sent, "datagram")} sent${err}`);
+  }
+
+  /** Closes the socket, if open (a send error arriving meanwhile finds none). */
+  private close(): void {
+    const s = this.socket;
+    this.socket = undefined;
+    s?.close();
+  }
+}
