@@ -1,5 +1,14 @@
 import { z } from "zod";
-import { BlockConfigError, defineBlock, formatShape, type Frame } from "../../engine";
+import {
+  BlockConfigError,
+  defineBlock,
+  formatShape,
+  type BlockContext,
+  type BlockInstance,
+  type Frame,
+  type InputInfo,
+  type LslStreamInfo,
+} from "../../engine";
 import { formatCount, TextThrottle } from "../shared/text";
 import { bufferParam, defaultSourceId, nameParam, OutletLink } from "./lsl-common";
 import { MAX_ITEMS } from "../shared/limits";
@@ -56,6 +65,134 @@ export function markerText(v: number, labels: readonly string[]): string {
   return String(v);
 }
 
+/** Refuses a `Channel` that is not a value of the input (when its shape is known). */
+function checkChannel(input: InputInfo, channel: number): void {
+  const width = input.shape ? input.shape.rows * input.shape.cols : 0;
+  if (input.shape && channel >= width) {
+    throw new BlockConfigError(
+      `Channel ${channel} is not a value of input ${input.source} (${formatShape(input.shape)})`,
+      "Channel",
+    );
+  }
+}
+
+/** The marker stream's metadata: one irregular channel. */
+function markerStreamInfo(ctx: BlockContext, p: Params, name: string): LslStreamInfo {
+  return {
+    name,
+    type: p.Type,
+    channels: 1,
+    rate: 0,
+    format: p.Format,
+    sourceId: p.SourceId || defaultSourceId(ctx, name),
+  };
+}
+
+/** One LslMarkers' run: the outlet, the markers sent as chunks, the counters and the status. */
+class MarkersRun {
+  private readonly link: OutletLink;
+  private readonly throttle = new TextThrottle(0.25);
+  private codes = new Float64Array(0);
+  private times = new Float64Array(0);
+  private readonly texts: string[] = [];
+  private sent = 0;
+  private last = "";
+  private clamped = 0;
+  private unsent = 0;
+
+  constructor(
+    private readonly ctx: BlockContext,
+    private readonly p: Params,
+    private readonly name: string,
+    info: LslStreamInfo,
+  ) {
+    this.link = new OutletLink(ctx, info, p.BufferSeconds);
+  }
+
+  /** The block's instance: start, process, stop, reset and dispose. */
+  instance(): BlockInstance {
+    return {
+      start: () => {
+        if (this.link.open()) this.describe();
+      },
+      process: (f: Frame) => this.process(f),
+      stop: () => {
+        this.describe();
+        this.link.close();
+      },
+      reset: () => this.reset(),
+      dispose: () => {
+        this.link.close();
+      },
+    };
+  }
+
+  /** Sends a frame's markers as one chunk (or counts them unsent while there is no outlet). */
+  private process(f: Frame): void {
+    if (f.n === 0) return;
+    if (!this.link.outlet) {
+      this.unsent += f.n;
+      return;
+    }
+    this.link.check();
+    this.sent += this.send(f);
+    if (this.throttle.due(this.ctx.now())) this.describe();
+  }
+
+  /** Pushes the frame's markers with their times on LSL's clock; returns how many were sent. */
+  private send(f: Frame): number {
+    const p = this.p;
+    const outlet = this.link.outlet!;
+    if (this.times.length < f.n) {
+      this.times = new Float64Array(f.n * 2);
+      this.codes = new Float64Array(f.n * 2);
+    }
+    this.texts.length = 0;
+    let k = 0;
+    for (let i = 0; i < f.n; i++) {
+      const v = f.v[i * f.stride + p.Channel]!;
+      if (Number.isNaN(v) && p.SkipNaN) continue;
+      this.times[k] = this.link.clock.toLsl(f.t[i]!);
+      if (p.Format === "string") {
+        this.last = Number.isNaN(v) ? p.NanMarker : markerText(v, p.Labels);
+        this.texts.push(this.last);
+      } else {
+        const c = Number.isNaN(v) ? p.NanCode : markerCode(v);
+        if (!Number.isNaN(v) && c !== Math.round(v)) this.clamped++;
+        this.codes[k] = c;
+        this.last = String(c);
+      }
+      k++;
+    }
+    if (k === 0) return 0;
+    if (p.Format === "string") outlet.pushStrings(this.texts, this.times.subarray(0, k));
+    else outlet.push(this.codes, k, this.times);
+    return k;
+  }
+
+  /** Shows the markers sent, the last one and what was clamped or not sent (unless it failed). */
+  private describe(): void {
+    if (this.link.failure !== "") return;
+    const tail = this.sent > 0 ? `, last '${this.last}'` : "";
+    const extra = [
+      this.clamped > 0 ? `${this.clamped} clamped to int32` : "",
+      this.unsent > 0 ? `${this.unsent} not sent (no outlet)` : "",
+    ].filter((s) => s !== "");
+    this.ctx.setText(
+      `markers '${this.name}' (${this.p.Format}): ${formatCount(this.sent)} sent${tail}` +
+        (extra.length > 0 ? `, ${extra.join(", ")}` : ""),
+    );
+  }
+
+  /** Clears the counters and the last marker. */
+  private reset(): void {
+    this.sent = 0;
+    this.clamped = 0;
+    this.unsent = 0;
+    this.last = "";
+  }
+}
+
 export const LslMarkers = defineBlock({
   type: "LslMarkers",
   category: "Communication",
@@ -73,105 +210,9 @@ export const LslMarkers = defineBlock({
   outputs: [],
   panel: "The marker stream's name, markers sent and the last one.",
   create(ctx, p: Params) {
-    const input = ctx.inputs[0]!;
-    const width = input.shape ? input.shape.rows * input.shape.cols : 0;
-    if (input.shape && p.Channel >= width) {
-      throw new BlockConfigError(
-        `Channel ${p.Channel} is not a value of input ${input.source} (${formatShape(input.shape)})`,
-        "Channel",
-      );
-    }
+    checkChannel(ctx.inputs[0]!, p.Channel);
     const name = p.Name || ctx.name;
-    const link = new OutletLink(
-      ctx,
-      {
-        name,
-        type: p.Type,
-        channels: 1,
-        rate: 0,
-        format: p.Format,
-        sourceId: p.SourceId || defaultSourceId(ctx, name),
-      },
-      p.BufferSeconds,
-    );
-    const throttle = new TextThrottle(0.25);
-    let codes = new Float64Array(0);
-    let times = new Float64Array(0);
-    const texts: string[] = [];
-    let sent = 0;
-    let last = "";
-    let clamped = 0;
-    let unsent = 0;
-
-    const describe = (): void => {
-      if (link.failure !== "") return;
-      const tail = sent > 0 ? `, last '${last}'` : "";
-      const extra = [
-        clamped > 0 ? `${clamped} clamped to int32` : "",
-        unsent > 0 ? `${unsent} not sent (no outlet)` : "",
-      ].filter((s) => s !== "");
-      ctx.setText(
-        `markers '${name}' (${p.Format}): ${formatCount(sent)} sent${tail}` +
-          (extra.length > 0 ? `, ${extra.join(", ")}` : ""),
-      );
-    };
-
-    const send = (f: Frame): number => {
-      const outlet = link.outlet!;
-      if (times.length < f.n) {
-        times = new Float64Array(f.n * 2);
-        codes = new Float64Array(f.n * 2);
-      }
-      texts.length = 0;
-      let k = 0;
-      for (let i = 0; i < f.n; i++) {
-        const v = f.v[i * f.stride + p.Channel]!;
-        if (Number.isNaN(v) && p.SkipNaN) continue;
-        times[k] = link.clock.toLsl(f.t[i]!);
-        if (p.Format === "string") {
-          last = Number.isNaN(v) ? p.NanMarker : markerText(v, p.Labels);
-          texts.push(last);
-        } else {
-          const c = Number.isNaN(v) ? p.NanCode : markerCode(v);
-          if (!Number.isNaN(v) && c !== Math.round(v)) clamped++;
-          codes[k] = c;
-          last = String(c);
-        }
-        k++;
-      }
-      if (k === 0) return 0;
-      if (p.Format === "string") outlet.pushStrings(texts, times.subarray(0, k));
-      else outlet.push(codes, k, times);
-      return k;
-    };
-
-    return {
-      start() {
-        if (link.open()) describe();
-      },
-      process(f: Frame) {
-        if (f.n === 0) return;
-        if (!link.outlet) {
-          unsent += f.n;
-          return;
-        }
-        link.check();
-        sent += send(f);
-        if (throttle.due(ctx.now())) describe();
-      },
-      stop() {
-        describe();
-        link.close();
-      },
-      reset() {
-        sent = 0;
-        clamped = 0;
-        unsent = 0;
-        last = "";
-      },
-      dispose() {
-        link.close();
-      },
-    };
+    const info = markerStreamInfo(ctx, p, name);
+    return new MarkersRun(ctx, p, name, info).instance();
   },
 });

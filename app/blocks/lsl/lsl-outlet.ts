@@ -1,5 +1,15 @@
 import { z } from "zod";
-import { BlockConfigError, defineBlock, formatShape, type Frame } from "../../engine";
+import {
+  BlockConfigError,
+  defineBlock,
+  formatShape,
+  type BlockContext,
+  type BlockInstance,
+  type Frame,
+  type InputInfo,
+  type LslStreamInfo,
+  type Shape,
+} from "../../engine";
 import { formatCount, TextThrottle } from "../shared/text";
 import {
   bufferParam,
@@ -47,6 +57,162 @@ const params = z.strictObject({
 });
 type Params = z.output<typeof params>;
 
+/** The input's shape, refused when it is unknown. */
+function knownShape(input: InputInfo): Shape {
+  if (!input.shape) {
+    throw new BlockConfigError("the input's shape is unknown (a feedback cycle?)", "Inputs");
+  }
+  return input.shape;
+}
+
+/** The stream's channel count: the input's values per event, refused when there are none. */
+function inputChannels(input: InputInfo, shape: Shape): number {
+  const channels = shape.rows * shape.cols;
+  if (channels === 0) {
+    throw new BlockConfigError(
+      `input ${input.source} carries no values (${formatShape(shape)}): use LslMarkers for events`,
+      "Inputs",
+    );
+  }
+  return channels;
+}
+
+/** The channel labels: `ChannelLabels` (one per channel, else refused) or Ch1, Ch2, …. */
+function channelLabels(
+  given: readonly string[] | undefined,
+  channels: number,
+  shape: Shape,
+): readonly string[] {
+  const labels = given ?? Array.from({ length: channels }, (_, i) => `Ch${i + 1}`);
+  if (labels.length !== channels) {
+    throw new BlockConfigError(
+      `${labels.length} ChannelLabels for ${channels} channels (input ${formatShape(shape)})`,
+      "ChannelLabels",
+    );
+  }
+  return labels;
+}
+
+/** The stream's metadata as inlets see it. */
+function streamInfo(
+  ctx: BlockContext,
+  p: Params,
+  inputRate: number,
+  channels: number,
+  labels: readonly string[],
+): LslStreamInfo & { labels: readonly string[] } {
+  const name = p.Name || ctx.name;
+  return {
+    name,
+    type: p.Type,
+    channels,
+    rate: p.NominalRate ?? inputRate,
+    format: p.Format,
+    sourceId: p.SourceId || defaultSourceId(ctx, name),
+    labels,
+  };
+}
+
+/** One LslOutlet's run: the outlet, the frames sent as chunks, the counters and the status. */
+class OutletRun {
+  private readonly link: OutletLink;
+  private readonly throttle = new TextThrottle(0.25);
+  private values = new Float64Array(0);
+  private times = new Float64Array(0);
+  private strings: string[] = [];
+  private samples = 0;
+  private chunks = 0;
+  private clamped = 0;
+  private unsent = 0;
+
+  constructor(
+    private readonly ctx: BlockContext,
+    private readonly format: Params["Format"],
+    private readonly info: LslStreamInfo,
+    bufferS: number,
+  ) {
+    this.link = new OutletLink(ctx, info, bufferS);
+  }
+
+  /** The block's instance: start, process, stop, reset and dispose. */
+  instance(): BlockInstance {
+    return {
+      start: () => {
+        if (this.link.open()) this.describe();
+      },
+      process: (f: Frame) => this.process(f),
+      stop: () => {
+        this.describe();
+        this.link.close();
+      },
+      reset: () => this.reset(),
+      dispose: () => {
+        this.link.close();
+      },
+    };
+  }
+
+  /** Sends a frame as one chunk and counts it (or counts it unsent while there is no outlet). */
+  private process(f: Frame): void {
+    if (f.n === 0) return;
+    if (!this.link.outlet) {
+      this.unsent += f.n;
+      return;
+    }
+    this.link.check();
+    this.send(f);
+    this.samples += f.n;
+    this.chunks++;
+    if (this.throttle.due(this.ctx.now())) this.describe();
+  }
+
+  /** Pushes the frame's values in the stream's format, with its times on LSL's clock. */
+  private send(f: Frame): void {
+    const outlet = this.link.outlet!;
+    const n = f.n;
+    if (this.times.length < n) this.times = new Float64Array(n * 2);
+    for (let i = 0; i < n; i++) this.times[i] = this.link.clock.toLsl(f.t[i]!);
+    const m = n * this.info.channels;
+    if (this.format === "string") {
+      this.strings.length = m;
+      for (let k = 0; k < m; k++) this.strings[k] = String(f.v[k]!);
+      outlet.pushStrings(this.strings, this.times.subarray(0, n));
+      return;
+    }
+    if (this.format === "int32" || this.format === "int16") {
+      if (this.values.length < m) this.values = new Float64Array(m * 2);
+      this.values.set(f.v.subarray(0, m));
+      this.clamped += toIntegerFormat(this.values, m, this.format);
+      outlet.push(this.values, n, this.times);
+      return;
+    }
+    outlet.push(f.v, n, this.times);
+  }
+
+  /** Shows the stream, what was sent, whether an inlet listens (unless the outlet failed). */
+  private describe(): void {
+    if (this.link.failure !== "") return;
+    const parts = [
+      `streaming '${this.info.name}' (${describeStream(this.info)})`,
+      `${formatCount(this.samples)} samples in ${formatCount(this.chunks)} chunks`,
+      this.link.outlet?.haveConsumers() ? "an inlet listens" : "no inlet connected",
+    ];
+    if (this.clamped > 0)
+      parts.push(`${formatCount(this.clamped)} values clamped to ${this.format}`);
+    if (this.unsent > 0) parts.push(`${formatCount(this.unsent)} samples not sent (no outlet)`);
+    this.ctx.setText(parts.join(", "));
+  }
+
+  /** Clears the counters. */
+  private reset(): void {
+    this.samples = 0;
+    this.chunks = 0;
+    this.clamped = 0;
+    this.unsent = 0;
+    this.strings = [];
+  }
+}
+
 export const LslOutlet = defineBlock({
   type: "LslOutlet",
   category: "Communication",
@@ -69,107 +235,10 @@ export const LslOutlet = defineBlock({
   panel: "The stream's name, format and rate, samples and chunks sent, whether an inlet listens.",
   create(ctx, p: Params) {
     const input = ctx.inputs[0]!;
-    if (!input.shape) {
-      throw new BlockConfigError("the input's shape is unknown (a feedback cycle?)", "Inputs");
-    }
-    const channels = input.shape.rows * input.shape.cols;
-    if (channels === 0) {
-      throw new BlockConfigError(
-        `input ${input.source} carries no values (${formatShape(input.shape)}): use LslMarkers for events`,
-        "Inputs",
-      );
-    }
-    const labels = p.ChannelLabels ?? Array.from({ length: channels }, (_, i) => `Ch${i + 1}`);
-    if (labels.length !== channels) {
-      throw new BlockConfigError(
-        `${labels.length} ChannelLabels for ${channels} channels (input ${formatShape(input.shape)})`,
-        "ChannelLabels",
-      );
-    }
-    const name = p.Name || ctx.name;
-    const info = {
-      name,
-      type: p.Type,
-      channels,
-      rate: p.NominalRate ?? input.rate,
-      format: p.Format,
-      sourceId: p.SourceId || defaultSourceId(ctx, name),
-      labels,
-    };
-    const link = new OutletLink(ctx, info, p.BufferSeconds);
-    const throttle = new TextThrottle(0.25);
-    let values = new Float64Array(0);
-    let times = new Float64Array(0);
-    let strings: string[] = [];
-    let samples = 0;
-    let chunks = 0;
-    let clamped = 0;
-    let unsent = 0;
-
-    const describe = (): void => {
-      if (link.failure !== "") return;
-      const parts = [
-        `streaming '${name}' (${describeStream(info)})`,
-        `${formatCount(samples)} samples in ${formatCount(chunks)} chunks`,
-        link.outlet?.haveConsumers() ? "an inlet listens" : "no inlet connected",
-      ];
-      if (clamped > 0) parts.push(`${formatCount(clamped)} values clamped to ${p.Format}`);
-      if (unsent > 0) parts.push(`${formatCount(unsent)} samples not sent (no outlet)`);
-      ctx.setText(parts.join(", "));
-    };
-
-    const send = (f: Frame): void => {
-      const outlet = link.outlet!;
-      const n = f.n;
-      if (times.length < n) times = new Float64Array(n * 2);
-      for (let i = 0; i < n; i++) times[i] = link.clock.toLsl(f.t[i]!);
-      const m = n * channels;
-      if (p.Format === "string") {
-        strings.length = m;
-        for (let k = 0; k < m; k++) strings[k] = String(f.v[k]!);
-        outlet.pushStrings(strings, times.subarray(0, n));
-        return;
-      }
-      if (p.Format === "int32" || p.Format === "int16") {
-        if (values.length < m) values = new Float64Array(m * 2);
-        values.set(f.v.subarray(0, m));
-        clamped += toIntegerFormat(values, m, p.Format);
-        outlet.push(values, n, times);
-        return;
-      }
-      outlet.push(f.v, n, times);
-    };
-
-    return {
-      start() {
-        if (link.open()) describe();
-      },
-      process(f: Frame) {
-        if (f.n === 0) return;
-        if (!link.outlet) {
-          unsent += f.n;
-          return;
-        }
-        link.check();
-        send(f);
-        samples += f.n;
-        chunks++;
-        if (throttle.due(ctx.now())) describe();
-      },
-      stop() {
-        describe();
-        link.close();
-      },
-      reset() {
-        samples = 0;
-        chunks = 0;
-        clamped = 0;
-        unsent = 0;
-        strings = [];
-      },
-      dispose() {
-        link.close();
-      },
-    };
+    const shape = knownShape(input);
+    const channels = inputChannels(input, shape);
+    const labels = channelLabels(p.ChannelLabels, channels, shape);
+    const info = streamInfo(ctx, p, input.rate, channels, labels);
+    return new OutletRun(ctx, p.Format, info, p.BufferSeconds).instance();
   },
 });
