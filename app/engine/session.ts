@@ -316,38 +316,16 @@ export class EngineSession {
     this.platform.post({ type: "state", state, file: this.file });
   }
 
+  /** Carries out one request from the UI and replies to it (errors are replied by the caller). */
   private async dispatch(msg: UiMessage): Promise<void> {
     switch (msg.type) {
       case "hello":
         this.platform.post(this.hello());
         return;
-      case "load": {
-        // One load at a time: a load may wait for its parse (platform.loadPipeline).
-        const run = this.loading.then(() =>
-          this.load(msg.file, msg.source, msg.simulateDevices === true, msg.folder),
-        );
-        this.loading = run.catch(() => {});
-        const { diagnostics, graph } = await run;
-        const ok = graph !== undefined;
-        this.reply(msg.id, ok, ok ? undefined : "the pipeline has errors", {
-          diagnostics,
-          ...(graph ? { graph } : {}),
-        });
-        return;
-      }
-      case "validate": {
-        // What `mosaic validate` says of the text (app/engine/validate.ts); the running pipeline stays.
-        const own = await this.ownBlocks(msg.source, msg.file);
-        const parse = this.platform.loadPipeline?.bind(this.platform);
-        const diagnostics = own.failed
-          ? own.diagnostics
-          : await validatePipeline(msg.source, msg.file, own.catalog, {
-              resources: this.platform.resources(msg.file, msg.folder),
-              ...(parse ? { parse: (text, f) => parse(text, f, own.catalog) } : {}),
-            });
-        this.reply(msg.id, true, undefined, { diagnostics });
-        return;
-      }
+      case "load":
+        return this.loadRequest(msg);
+      case "validate":
+        return this.validateRequest(msg);
       case "catalog":
         this.reply(msg.id, true, undefined, { catalog: this.catalogInfo() });
         return;
@@ -359,46 +337,19 @@ export class EngineSession {
         this.stop();
         this.reply(msg.id, true);
         return;
-      case "setParam": {
-        const rt = this.requireRuntime();
-        const said = rt.setParam(msg.block, msg.param, msg.value);
-        // Every client shows the engine's value (issue 17, defect 1).
-        this.platform.post({ type: "params", blocks: [this.blockParams(msg.block)] });
-        this.reply(msg.id, true, said);
+      case "setParam":
+        this.reply(msg.id, true, this.setParam(msg));
         return;
-      }
       case "params-written":
         this.reply(msg.id, true, this.paramsWritten(msg));
         return;
-      case "invoke": {
-        const rt = this.requireRuntime();
-        const m = rt.invoke(msg.block, msg.action, msg.arg);
-        this.loop?.wake();
-        this.reply(msg.id, true, m);
+      case "invoke":
+        this.reply(msg.id, true, this.invoke(msg));
         return;
-      }
-      case "watch": {
-        const rt = this.requireRuntime();
-        const node = rt.node(msg.block);
-        if (!node) throw new Error(`no block '${msg.block}'`);
-        const port = msg.port ?? node.ports[0]?.name;
-        const p = node.ports.find((x) => x.name === port);
-        if (!p) throw new Error(`block '${msg.block}' has no output '${msg.port ?? "(default)"}'`);
-        const key = `${msg.block}.${p.name}`;
-        this.watches.get(key)?.untap();
-        const w = new Watch(
-          msg.block,
-          p.name,
-          p.shape.rows,
-          p.shape.cols,
-          node.desiredRate,
-          msg.maxRate ?? 500,
-        );
-        w.untap = rt.tap(msg.block, p.name, (f) => w.add(f));
-        this.watches.set(key, w);
+      case "watch":
+        this.watch(msg);
         this.reply(msg.id, true);
         return;
-      }
       case "record-start":
         this.reply(msg.id, true, this.startRecording(msg));
         return;
@@ -407,15 +358,84 @@ export class EngineSession {
         this.reply(msg.id, m !== undefined, m ?? "no recording is running");
         return;
       }
-      case "unwatch": {
-        for (const [key, w] of this.watches) {
-          if (w.block === msg.block && (msg.port === undefined || w.port === msg.port)) {
-            w.untap();
-            this.watches.delete(key);
-          }
-        }
+      case "unwatch":
+        this.unwatch(msg);
         this.reply(msg.id, true);
         return;
+    }
+  }
+
+  /** Loads a pipeline (one load at a time: a load may wait for its parse) and replies with it. */
+  private async loadRequest(msg: Extract<UiMessage, { type: "load" }>): Promise<void> {
+    const run = this.loading.then(() =>
+      this.load(msg.file, msg.source, msg.simulateDevices === true, msg.folder),
+    );
+    this.loading = run.catch(() => {});
+    const { diagnostics, graph } = await run;
+    const ok = graph !== undefined;
+    this.reply(msg.id, ok, ok ? undefined : "the pipeline has errors", {
+      diagnostics,
+      ...(graph ? { graph } : {}),
+    });
+  }
+
+  /** What `mosaic validate` says of the text (app/engine/validate.ts); the running pipeline stays. */
+  private async validateRequest(msg: Extract<UiMessage, { type: "validate" }>): Promise<void> {
+    const own = await this.ownBlocks(msg.source, msg.file);
+    const parse = this.platform.loadPipeline?.bind(this.platform);
+    const diagnostics = own.failed
+      ? own.diagnostics
+      : await validatePipeline(msg.source, msg.file, own.catalog, {
+          resources: this.platform.resources(msg.file, msg.folder),
+          ...(parse ? { parse: (text, f) => parse(text, f, own.catalog) } : {}),
+        });
+    this.reply(msg.id, true, undefined, { diagnostics });
+  }
+
+  /** Sets a live param; every client is sent the engine's value (issue 17, defect 1). */
+  private setParam(msg: Extract<UiMessage, { type: "setParam" }>): string {
+    const rt = this.requireRuntime();
+    const said = rt.setParam(msg.block, msg.param, msg.value);
+    this.platform.post({ type: "params", blocks: [this.blockParams(msg.block)] });
+    return said;
+  }
+
+  /** Runs a block's action, and has the loop look at once (the action may have made events). */
+  private invoke(msg: Extract<UiMessage, { type: "invoke" }>): string {
+    const rt = this.requireRuntime();
+    const m = rt.invoke(msg.block, msg.action, msg.arg);
+    this.loop?.wake();
+    return m;
+  }
+
+  /** Starts sending a block output's data for a panel (a watch of the same output is replaced). */
+  private watch(msg: Extract<UiMessage, { type: "watch" }>): void {
+    const rt = this.requireRuntime();
+    const node = rt.node(msg.block);
+    if (!node) throw new Error(`no block '${msg.block}'`);
+    const port = msg.port ?? node.ports[0]?.name;
+    const p = node.ports.find((x) => x.name === port);
+    if (!p) throw new Error(`block '${msg.block}' has no output '${msg.port ?? "(default)"}'`);
+    const key = `${msg.block}.${p.name}`;
+    this.watches.get(key)?.untap();
+    const w = new Watch(
+      msg.block,
+      p.name,
+      p.shape.rows,
+      p.shape.cols,
+      node.desiredRate,
+      msg.maxRate ?? 500,
+    );
+    w.untap = rt.tap(msg.block, p.name, (f) => w.add(f));
+    this.watches.set(key, w);
+  }
+
+  /** Stops the watches of a block (of one output, or all of them). */
+  private unwatch(msg: Extract<UiMessage, { type: "unwatch" }>): void {
+    for (const [key, w] of this.watches) {
+      if (w.block === msg.block && (msg.port === undefined || w.port === msg.port)) {
+        w.untap();
+        this.watches.delete(key);
       }
     }
   }
