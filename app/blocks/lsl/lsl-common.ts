@@ -6,6 +6,8 @@ import { z } from "zod";
 import {
   BlockConfigError,
   type BlockContext,
+  type BlockInstance,
+  type Frame,
   type LslBridge,
   type LslFormat,
   type LslOutletHandle,
@@ -162,6 +164,25 @@ export class OutletLink {
   close(): void {
     this.outlet?.close();
     this.outlet = undefined;
+  }
+
+  /**
+   * The block instance of an outlet block (LslOutlet, LslMarkers): the outlet opens at start (the
+   * status then shows it), closes at stop after the last status, and at dispose.
+   */
+  instance(run: { process(f: Frame): void; describe(): void; reset(): void }): BlockInstance {
+    return {
+      start: () => {
+        if (this.open()) run.describe();
+      },
+      process: (f: Frame) => run.process(f),
+      stop: () => {
+        run.describe();
+        this.close();
+      },
+      reset: () => run.reset(),
+      dispose: () => this.close(),
+    };
   }
 }
 

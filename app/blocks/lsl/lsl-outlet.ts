@@ -134,22 +134,13 @@ class OutletRun {
     this.link = new OutletLink(ctx, info, bufferS);
   }
 
-  /** The block's instance: start, process, stop, reset and dispose. */
+  /** The block's instance (see OutletLink.instance). */
   instance(): BlockInstance {
-    return {
-      start: () => {
-        if (this.link.open()) this.describe();
-      },
-      process: (f: Frame) => this.process(f),
-      stop: () => {
-        this.describe();
-        this.link.close();
-      },
+    return this.link.instance({
+      process: (f) => this.process(f),
+      describe: () => this.describe(),
       reset: () => this.reset(),
-      dispose: () => {
-        this.link.close();
-      },
-    };
+    });
   }
 
   /** Sends a frame as one chunk and counts it (or counts it unsent while there is no outlet). */
