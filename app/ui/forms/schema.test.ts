@@ -417,3 +417,194 @@ suite("validate", () => {
     expect(emptyValue(describe({ type: "string", enum: ["a", "b"] }))).toBe("a");
   });
 });
+
+suite("describe: the remaining shapes", () => {
+  it("booleans, strings with bounds, lists and matrices with bounds", () => {
+    expect(describe({ type: "boolean", default: true })).toMatchObject({
+      kind: "boolean",
+      default: true,
+    });
+    expect(describe({ type: "string", minLength: 1, maxLength: 8, pattern: "^a" })).toMatchObject({
+      kind: "string",
+      minLength: 1,
+      maxLength: 8,
+      pattern: "^a",
+    });
+    expect(describe({ type: "array", maxItems: 3, items: { type: "string" } })).toMatchObject({
+      kind: "list",
+      maxItems: 3,
+      item: { kind: "string" },
+    });
+    expect(
+      describe({ type: "array", minItems: 2, maxItems: 3, items: { type: "number" } }),
+    ).toMatchObject({ kind: "numberList", minItems: 2, maxItems: 3 });
+    const m = describe({
+      type: "array",
+      maxItems: 4,
+      items: { type: "array", items: { type: "number" } },
+    });
+    expect(m).toMatchObject({ kind: "matrix", maxRows: 4 });
+    expect("minRows" in m).toBe(false);
+    expect(describe({ type: "array", items: [{ type: "number" }] }).kind).toBe("json");
+  });
+
+  it("objects, records and the JSON fallbacks for types", () => {
+    const rec = describe({ type: "object", additionalProperties: { type: "number" } });
+    expect(rec).toMatchObject({ kind: "record", value: { kind: "number" } });
+    expect("keySchema" in rec).toBe(false);
+    expect(describe({ type: "object" }).kind).toBe("json");
+    expect(describe({ type: "object", additionalProperties: true }).kind).toBe("json");
+    expect(describe({ type: "object", additionalProperties: false })).toMatchObject({
+      kind: "object",
+      fields: [],
+    });
+    expect(describe({ type: ["string", "number"] }).kind).toBe("json");
+    expect(describe({ type: "null" }).kind).toBe("json");
+    expect(describeParams({ type: "number" })).toMatchObject({ kind: "object", fields: [] });
+  });
+
+  it("unions: scalar unions, nullable constants, allOf, annotations of the outer schema", () => {
+    const u = describe({ anyOf: [{ type: "string" }, { type: "integer" }], description: "d" });
+    expect(u).toMatchObject({ kind: "scalarUnion", description: "d" });
+    expect((u as { branches: Field[] }).branches.map((b) => b.kind)).toEqual(["string", "number"]);
+    const safe = describe({
+      anyOf: [
+        { type: "string", enum: ["rest"] },
+        { type: "array", items: { type: "number" } },
+      ],
+    });
+    expect(safe.kind).toBe("scalarUnion");
+    const nc = describe({
+      anyOf: [{ const: "x" }, { type: "null" }],
+      description: "outer",
+      default: "x",
+    });
+    expect(nc).toMatchObject({
+      kind: "enum",
+      nullable: true,
+      description: "outer",
+      default: "x",
+      options: [{ value: "x", label: "x" }],
+    });
+    expect(
+      describe({ allOf: [{ type: "integer" }, { minimum: 2 }], description: "both" }),
+    ).toMatchObject({ kind: "number", integer: true, min: 2, description: "both" });
+    expect(describe({ oneOf: [{ type: "null" }] })).toMatchObject({
+      kind: "json",
+      nullable: true,
+    });
+    const two = describe({ anyOf: [{ type: "number" }, { type: "number" }] });
+    expect(two.kind).toBe("scalarUnion");
+  });
+});
+
+suite("validate: the remaining checks, in order", () => {
+  it("types, allOf, infinities and zod's safe-integer bounds", () => {
+    expect(messages({ type: ["number", "null"] }, "x")).toEqual(["must be a number or empty"]);
+    expect(messages({ type: "custom" }, 1)).toEqual([]);
+    expect(messages({ allOf: [{ type: "number", minimum: 2 }, { maximum: 0 }] }, 1)).toEqual([
+      "must be ≥ 2",
+      "must be ≤ 0",
+    ]);
+    expect(messages({ type: "number" }, Infinity)).toEqual(["must be a finite number"]);
+    expect(messages({ type: "number", "x-infinity": true }, -Infinity)).toEqual([]);
+    expect(messages({ type: "number", maximum: 1 }, Infinity)).toEqual([
+      "must be a finite number",
+      "must be ≤ 1",
+    ]);
+    const SAFE = Number.MAX_SAFE_INTEGER;
+    const int: JsonSchema = { type: "integer", minimum: -SAFE, maximum: SAFE };
+    expect(messages(int, 2 ** 60)).toEqual([`must be ≤ ${SAFE}`]);
+    expect(messages(int, -(2 ** 60))).toEqual([`must be ≥ ${-SAFE}`]);
+    expect(messages({ type: "number", multipleOf: 0 }, 0.3)).toEqual([]);
+    expect(messages({ const: 1, enum: [2, 3], minimum: 5 }, 1)).toEqual([
+      "must be one of 2, 3",
+      "must be ≥ 5",
+    ]);
+    expect(messages({ const: [1, { a: 2 }] }, [1, { a: 2, b: undefined }])).toEqual([]);
+  });
+
+  it("strings: length in code points, maxLength, a bad pattern is ignored", () => {
+    expect(messages({ type: "string", minLength: 3 }, "ab")).toEqual([
+      "must have at least 3 characters",
+    ]);
+    expect(messages({ type: "string", maxLength: 2 }, "😀😀")).toEqual([]);
+    expect(messages({ type: "string", maxLength: 2, pattern: "^z" }, "abc")).toEqual([
+      "must have at most 2 characters",
+      "must match ^z",
+    ]);
+    expect(messages({ type: "string", pattern: "(" }, "abc")).toEqual([]);
+  });
+
+  it("arrays: bounds, missing items, prefixItems and tuple items", () => {
+    expect(messages({ type: "array", minItems: 2 }, [1])).toEqual(["needs at least 2 items"]);
+    expect(messages({ type: "array", maxItems: 1 }, [1, 2])).toEqual(["must have at most 1 items"]);
+    expect(messages({ type: "array", items: { type: "number" } }, [1, undefined, "x"])).toEqual([
+      "[1]: item is missing",
+      "[2]: must be a number",
+    ]);
+    const tuple: JsonSchema = {
+      type: "array",
+      prefixItems: [{ type: "string" }],
+      items: { type: "number" },
+    };
+    expect(messages(tuple, [1, "x"])).toEqual(["[0]: must be text", "[1]: must be a number"]);
+    expect(messages({ type: "array", items: [{ type: "string" }] }, [1, 2])).toEqual([
+      "[0]: must be text",
+    ]);
+  });
+
+  it("objects: checks only for object schemas, key order, unknown keys without properties", () => {
+    expect(messages({ required: ["a"] }, {})).toEqual([]);
+    expect(
+      messages({ properties: { a: { type: "number" } }, required: ["b"] }, { a: "x" }),
+    ).toEqual(["b: required", "a: must be a number"]);
+    expect(messages({ type: "object", additionalProperties: false }, { k: 1 })).toEqual([
+      "k: unknown key 'k'",
+    ]);
+    expect(
+      messages(
+        { type: "object", properties: { a: { type: "number" } }, additionalProperties: false },
+        { a: undefined, z: undefined },
+      ),
+    ).toEqual([]);
+    const keys: JsonSchema = {
+      type: "object",
+      propertyNames: { type: "string", minLength: 2 },
+      properties: { a: { type: "number" } },
+    };
+    expect(messages(keys, { a: "x", bb: 1 })).toEqual([
+      "a: name 'a' must have at least 2 characters",
+      "a: must be a number",
+    ]);
+    expect(messages({ type: "object" }, new InvalidText("{", "not valid JSON"))).toEqual([
+      "not valid JSON",
+    ]);
+    expect(messages({ type: "object" }, [1])).toEqual(["must be a mapping"]);
+  });
+
+  it("unions: allOf issues first; several branches of the value's type: what is expected", () => {
+    const s: JsonSchema = {
+      allOf: [{ minimum: 10 }],
+      anyOf: [
+        { type: "number", maximum: 1 },
+        { type: "integer", maximum: 2 },
+      ],
+    };
+    expect(messages(s, 5)).toEqual(["must be ≥ 10", "must be a number ≤ 1, or a whole number ≤ 2"]);
+    expect(messages({ allOf: [{ minimum: 10 }], anyOf: [{ type: "number" }] }, 5)).toEqual([
+      "must be ≥ 10",
+    ]);
+    expect(
+      messages({ oneOf: [{ type: "string" }, { type: "array", items: { type: "number" } }] }, [
+        "x",
+      ]),
+    ).toEqual(["[0]: must be a number"]);
+    expect(messages({ anyOf: [{ const: "a" }, { const: "a" }] }, "b")).toEqual(["must be a"]);
+    expect(
+      validate({ $ref: "#/$defs/n", $defs: { n: { type: "number", minimum: 0 } } }, -1, undefined, [
+        "p",
+      ]),
+    ).toEqual([{ path: ["p"], message: "must be ≥ 0" }]);
+  });
+});

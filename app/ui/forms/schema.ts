@@ -291,40 +291,49 @@ export function describe(
 ): Field {
   const outer = flatten(asSchema(schema), root);
   const { branches, nullable } = branchesOf(outer, root);
-  // The annotations (description, default) live on the outer schema of a union.
-  const annotate = (inner: JsonSchema): JsonSchema => {
-    const s: JsonSchema = { ...inner };
-    if (outer.description !== undefined) s.description = outer.description;
-    if ("default" in outer) s.default = outer.default;
-    return s;
-  };
   if (branches.length === 0) return { kind: "json", ...common(name, outer, required, nullable) };
   if (branches.length > 1) {
-    const c = common(name, outer, required, nullable);
-    // Constants and booleans only → a select.
-    if (branches.every((b) => isConstLike(b) || types(b)[0] === "boolean")) {
-      const options: EnumOption[] = [];
-      for (const b of branches)
-        for (const v of constValues(b)) options.push({ value: v, label: optionLabel(v) });
-      return { kind: "enum", options, ...c };
-    }
-    const described = branches.map((b) => describe(b, "", true, root));
-    const num = described.find((d): d is NumberField => d.kind === "number");
-    const list = described.find((d): d is NumberListField => d.kind === "numberList");
-    if (described.length === 2 && num && list) {
-      return { kind: "numberOrList", number: num, list, ...c };
-    }
-    const scalar = (d: Field): boolean =>
-      d.kind === "number" || d.kind === "string" || d.kind === "enum" || d.kind === "boolean";
-    if (described.every(scalar)) return { kind: "scalarUnion", branches: described, ...c };
-    // A scalar choice or a list of numbers (e.g. Safe: rest | hold | [values]).
-    if (described.every((d) => scalar(d) || d.kind === "numberList")) {
-      return { kind: "scalarUnion", branches: described, ...c };
-    }
-    return { kind: "json", ...c };
+    return describeUnion(branches, common(name, outer, required, nullable), root);
   }
-  const s = nullable ? annotate(branches[0]!) : branches[0]!;
-  const c = common(name, s, required, nullable);
+  const s = nullable ? annotate(branches[0]!, outer) : branches[0]!;
+  return describeSingle(s, common(name, s, required, nullable), root);
+}
+
+/** The one branch of a nullable union, given the outer schema's description and default. */
+function annotate(inner: JsonSchema, outer: JsonSchema): JsonSchema {
+  const s: JsonSchema = { ...inner };
+  if (outer.description !== undefined) s.description = outer.description;
+  if ("default" in outer) s.default = outer.default;
+  return s;
+}
+
+/** A union of several (non-null) branches: a select, a number-or-list, a scalar union, or JSON. */
+function describeUnion(branches: JsonSchema[], c: Common, root: JsonSchema): Field {
+  // Constants and booleans only → a select.
+  if (branches.every((b) => isConstLike(b) || types(b)[0] === "boolean")) {
+    const options: EnumOption[] = [];
+    for (const b of branches)
+      for (const v of constValues(b)) options.push({ value: v, label: optionLabel(v) });
+    return { kind: "enum", options, ...c };
+  }
+  const described = branches.map((b) => describe(b, "", true, root));
+  const num = described.find((d): d is NumberField => d.kind === "number");
+  const list = described.find((d): d is NumberListField => d.kind === "numberList");
+  if (described.length === 2 && num && list) {
+    return { kind: "numberOrList", number: num, list, ...c };
+  }
+  const scalar = (d: Field): boolean =>
+    d.kind === "number" || d.kind === "string" || d.kind === "enum" || d.kind === "boolean";
+  if (described.every(scalar)) return { kind: "scalarUnion", branches: described, ...c };
+  // A scalar choice or a list of numbers (e.g. Safe: rest | hold | [values]).
+  if (described.every((d) => scalar(d) || d.kind === "numberList")) {
+    return { kind: "scalarUnion", branches: described, ...c };
+  }
+  return { kind: "json", ...c };
+}
+
+/** A schema that is not a union: by its constants, else by its one type. */
+function describeSingle(s: JsonSchema, c: Common, root: JsonSchema): Field {
   if (isConstLike(s)) {
     return {
       kind: "enum",
@@ -336,60 +345,75 @@ export function describe(
   const kind = t.length === 1 ? t[0] : undefined;
   switch (kind) {
     case "number":
-    case "integer": {
-      const integer = kind === "integer";
-      const allowInfinity = !integer && acceptsInfinity(s);
-      // JSON writes a default of Infinity as null.
-      if (allowInfinity && c.default === null) c.default = Infinity;
-      return {
-        kind: "number",
-        integer,
-        step: integer ? 1 : "any",
-        allowInfinity,
-        ...numberLimits(s),
-        ...c,
-      };
-    }
+    case "integer":
+      return describeNumber(s, c, kind === "integer");
     case "boolean":
       return { kind: "boolean", ...c };
-    case "string": {
-      const f: StringField = { kind: "string", ...c };
-      if (s.minLength !== undefined) f.minLength = s.minLength;
-      if (s.maxLength !== undefined) f.maxLength = s.maxLength;
-      if (s.pattern !== undefined) f.pattern = s.pattern;
-      return f;
-    }
-    case "array": {
-      if (Array.isArray(s.items) || s.prefixItems) return { kind: "json", ...c };
-      const item = describe(typeof s.items === "object" ? s.items : {}, "", true, root);
-      const bounds: { minItems?: number; maxItems?: number } = {};
-      if (s.minItems !== undefined) bounds.minItems = s.minItems;
-      if (s.maxItems !== undefined) bounds.maxItems = s.maxItems;
-      if (item.kind === "number") return { kind: "numberList", item, ...bounds, ...c };
-      if (item.kind === "numberList") {
-        const m: MatrixField = { kind: "matrix", row: item, ...c };
-        if (bounds.minItems !== undefined) m.minRows = bounds.minItems;
-        if (bounds.maxItems !== undefined) m.maxRows = bounds.maxItems;
-        return m;
-      }
-      return { kind: "list", item, ...bounds, ...c };
-    }
-    case "object": {
-      const props = s.properties ?? {};
-      const req = new Set(s.required ?? []);
-      const fields = Object.entries(props).map(([k, p]) => describe(p, k, req.has(k), root));
-      const extra = s.additionalProperties;
-      if (fields.length === 0 && extra !== undefined && typeof extra === "object") {
-        const r: RecordField = { kind: "record", value: describe(extra, "", true, root), ...c };
-        if (s.propertyNames) r.keySchema = resolveRef(s.propertyNames, root);
-        return r;
-      }
-      if (fields.length === 0 && extra !== false) return { kind: "json", ...c };
-      return { kind: "object", fields, ...c };
-    }
+    case "string":
+      return describeString(s, c);
+    case "array":
+      return describeArray(s, c, root);
+    case "object":
+      return describeObject(s, c, root);
     default:
       return { kind: "json", ...c };
   }
+}
+
+/** A number or integer field, with its limits; a default of Infinity comes as null. */
+function describeNumber(s: JsonSchema, c: Common, integer: boolean): NumberField {
+  const allowInfinity = !integer && acceptsInfinity(s);
+  // JSON writes a default of Infinity as null.
+  if (allowInfinity && c.default === null) c.default = Infinity;
+  return {
+    kind: "number",
+    integer,
+    step: integer ? 1 : "any",
+    allowInfinity,
+    ...numberLimits(s),
+    ...c,
+  };
+}
+
+/** A text field, with its length bounds and pattern. */
+function describeString(s: JsonSchema, c: Common): StringField {
+  const f: StringField = { kind: "string", ...c };
+  if (s.minLength !== undefined) f.minLength = s.minLength;
+  if (s.maxLength !== undefined) f.maxLength = s.maxLength;
+  if (s.pattern !== undefined) f.pattern = s.pattern;
+  return f;
+}
+
+/** A list of numbers, a matrix (rows of numbers), a list of anything else, or JSON for tuples. */
+function describeArray(s: JsonSchema, c: Common, root: JsonSchema): Field {
+  if (Array.isArray(s.items) || s.prefixItems) return { kind: "json", ...c };
+  const item = describe(typeof s.items === "object" ? s.items : {}, "", true, root);
+  const bounds: { minItems?: number; maxItems?: number } = {};
+  if (s.minItems !== undefined) bounds.minItems = s.minItems;
+  if (s.maxItems !== undefined) bounds.maxItems = s.maxItems;
+  if (item.kind === "number") return { kind: "numberList", item, ...bounds, ...c };
+  if (item.kind === "numberList") {
+    const m: MatrixField = { kind: "matrix", row: item, ...c };
+    if (bounds.minItems !== undefined) m.minRows = bounds.minItems;
+    if (bounds.maxItems !== undefined) m.maxRows = bounds.maxItems;
+    return m;
+  }
+  return { kind: "list", item, ...bounds, ...c };
+}
+
+/** An object with its properties as fields, a record (free names → one schema), or JSON. */
+function describeObject(s: JsonSchema, c: Common, root: JsonSchema): Field {
+  const props = s.properties ?? {};
+  const req = new Set(s.required ?? []);
+  const fields = Object.entries(props).map(([k, p]) => describe(p, k, req.has(k), root));
+  const extra = s.additionalProperties;
+  if (fields.length === 0 && extra !== undefined && typeof extra === "object") {
+    const r: RecordField = { kind: "record", value: describe(extra, "", true, root), ...c };
+    if (s.propertyNames) r.keySchema = resolveRef(s.propertyNames, root);
+    return r;
+  }
+  if (fields.length === 0 && extra !== false) return { kind: "json", ...c };
+  return { kind: "object", fields, ...c };
 }
 
 /** The fields of a block's params form, one per top-level param, in schema order. */
@@ -780,10 +804,7 @@ export function validate(
   path: Path = [],
 ): Issue[] {
   const s = resolveRef(asSchema(schema), root);
-  const issues: Issue[] = [];
-  const add = (message: string, p: Path = path): void => {
-    issues.push({ path: p, message });
-  };
+  const { issues, add } = collector(path);
   if (value instanceof InvalidText) {
     add(value.error);
     return issues;
@@ -792,20 +813,7 @@ export function validate(
   for (const part of s.allOf ?? []) issues.push(...validate(part, value, root, path));
   const union = s.anyOf ?? s.oneOf;
   if (union) {
-    const results = union.map((b) => validate(b, value, root, path));
-    if (results.some((r) => r.length === 0)) return issues;
-    // Report the problems of the one branch of the value's own type, else say what is expected.
-    const own = union
-      .map((_b, i) => i)
-      .filter((i) => {
-        const b = resolveRef(union[i]!, root);
-        return !isConstLike(b) && types(b).some((x) => typeMatches(x, value));
-      });
-    if (own.length === 1) {
-      issues.push(...results[own[0]!]!);
-      return issues;
-    }
-    add(`must be ${unionWords(union, root)}`);
+    issues.push(...unionIssues(union, value, root, path));
     return issues;
   }
   const t = types(s);
@@ -813,85 +821,144 @@ export function validate(
     add(`must be ${t.map((x) => TYPE_WORDS[x] ?? x).join(" or ")}`);
     return issues;
   }
-  if ("const" in s && !deepEqual(s.const, value)) add(`must be ${optionLabel(s.const)}`);
-  if (Array.isArray(s.enum) && !s.enum.some((e) => deepEqual(e, value)))
-    add(`must be one of ${s.enum.map(optionLabel).join(", ")}`);
-  if (typeof value === "number") {
-    if (!Number.isFinite(value) && t.includes("number") && !acceptsInfinity(s))
-      add("must be a finite number");
-    const l = numberLimits(s);
-    if (l.min !== undefined && !(value >= l.min)) add(`must be ≥ ${formatNumber(l.min)}`);
-    if (l.max !== undefined && !(value <= l.max)) add(`must be ≤ ${formatNumber(l.max)}`);
-    if (l.exclusiveMin !== undefined && !(value > l.exclusiveMin))
-      add(`must be > ${formatNumber(l.exclusiveMin)}`);
-    if (l.exclusiveMax !== undefined && !(value < l.exclusiveMax))
-      add(`must be < ${formatNumber(l.exclusiveMax)}`);
-    // zod's .int() bounds (±2^53−1) are shown only when crossed.
-    if (typeof s.minimum === "number" && s.minimum <= -SAFE && value < s.minimum)
-      add(`must be ≥ ${s.minimum}`);
-    if (typeof s.maximum === "number" && s.maximum >= SAFE && value > s.maximum)
-      add(`must be ≤ ${s.maximum}`);
-    if (typeof s.multipleOf === "number" && s.multipleOf > 0) {
-      const q = value / s.multipleOf;
-      if (Math.abs(q - Math.round(q)) > 1e-9) add(`must be a multiple of ${s.multipleOf}`);
-    }
-  }
-  if (typeof value === "string") {
-    const n = [...value].length;
-    if (s.minLength !== undefined && n < s.minLength)
-      add(s.minLength === 1 ? "must not be empty" : `must have at least ${s.minLength} characters`);
-    if (s.maxLength !== undefined && n > s.maxLength)
-      add(`must have at most ${s.maxLength} characters`);
-    if (s.pattern !== undefined) {
-      let re: RegExp | undefined;
-      try {
-        re = new RegExp(s.pattern, "u");
-      } catch {
-        re = undefined;
-      }
-      if (re && !re.test(value)) add(`must match ${s.pattern}`);
-    }
-  }
-  if (Array.isArray(value)) {
-    if (s.minItems !== undefined && value.length < s.minItems)
-      add(s.minItems === 1 ? "needs at least 1 item" : `needs at least ${s.minItems} items`);
-    if (s.maxItems !== undefined && value.length > s.maxItems)
-      add(`must have at most ${s.maxItems} items`);
-    const prefix = s.prefixItems ?? (Array.isArray(s.items) ? s.items : undefined);
-    value.forEach((item, i) => {
-      const is =
-        prefix && i < prefix.length
-          ? prefix[i]
-          : typeof s.items === "object" && !Array.isArray(s.items)
-            ? s.items
-            : undefined;
-      if (item === undefined) add("item is missing", [...path, i]);
-      else if (is) issues.push(...validate(is, item, root, [...path, i]));
-    });
-  }
+  issues.push(...constIssues(s, value, path));
+  if (typeof value === "number") issues.push(...numberIssues(s, t, value, path));
+  if (typeof value === "string") issues.push(...stringIssues(s, value, path));
+  if (Array.isArray(value)) issues.push(...arrayIssues(s, value, root, path));
   if (
     typeMatches("object", value) &&
     (t.includes("object") || s.properties || s.additionalProperties !== undefined)
   ) {
-    const obj = value as Record<string, unknown>;
-    const props = s.properties ?? {};
-    for (const k of s.required ?? []) if (obj[k] === undefined) add("required", [...path, k]);
-    for (const [k, v] of Object.entries(obj)) {
-      if (v === undefined) continue;
-      if (s.propertyNames) {
-        const kIssues = validate(s.propertyNames, k, root, [...path, k]);
-        for (const i of kIssues) add(`name '${k}' ${i.message}`, i.path);
-      }
-      if (k in props) issues.push(...validate(props[k], v, root, [...path, k]));
-      else if (s.additionalProperties === false) {
-        const allowed = Object.keys(props);
-        add(`unknown key '${k}'${allowed.length ? ` (allowed: ${allowed.join(", ")})` : ""}`, [
-          ...path,
-          k,
-        ]);
-      } else if (typeof s.additionalProperties === "object")
-        issues.push(...validate(s.additionalProperties, v, root, [...path, k]));
+    issues.push(...objectIssues(s, value as Record<string, unknown>, root, path));
+  }
+  return issues;
+}
+
+/** A new list of issues and a function adding one at `path` (or at the path it is given). */
+function collector(path: Path): { issues: Issue[]; add: (message: string, p?: Path) => void } {
+  const issues: Issue[] = [];
+  const add = (message: string, p: Path = path): void => {
+    issues.push({ path: p, message });
+  };
+  return { issues, add };
+}
+
+/**
+ * A value against `anyOf` / `oneOf`: none if a branch accepts it, else the problems of the one
+ * branch of the value's own type, else what is expected.
+ */
+function unionIssues(union: JsonSchema[], value: unknown, root: JsonSchema, path: Path): Issue[] {
+  const results = union.map((b) => validate(b, value, root, path));
+  if (results.some((r) => r.length === 0)) return [];
+  const own = union
+    .map((_b, i) => i)
+    .filter((i) => {
+      const b = resolveRef(union[i]!, root);
+      return !isConstLike(b) && types(b).some((x) => typeMatches(x, value));
+    });
+  if (own.length === 1) return results[own[0]!]!;
+  return [{ path, message: `must be ${unionWords(union, root)}` }];
+}
+
+/** `const` and `enum`. */
+function constIssues(s: JsonSchema, value: unknown, path: Path): Issue[] {
+  const { issues, add } = collector(path);
+  if ("const" in s && !deepEqual(s.const, value)) add(`must be ${optionLabel(s.const)}`);
+  if (Array.isArray(s.enum) && !s.enum.some((e) => deepEqual(e, value)))
+    add(`must be one of ${s.enum.map(optionLabel).join(", ")}`);
+  return issues;
+}
+
+/** A number: finite unless infinities are accepted, bounds, zod's int bounds, multipleOf. */
+function numberIssues(s: JsonSchema, t: string[], value: number, path: Path): Issue[] {
+  const { issues, add } = collector(path);
+  if (!Number.isFinite(value) && t.includes("number") && !acceptsInfinity(s))
+    add("must be a finite number");
+  const l = numberLimits(s);
+  if (l.min !== undefined && !(value >= l.min)) add(`must be ≥ ${formatNumber(l.min)}`);
+  if (l.max !== undefined && !(value <= l.max)) add(`must be ≤ ${formatNumber(l.max)}`);
+  if (l.exclusiveMin !== undefined && !(value > l.exclusiveMin))
+    add(`must be > ${formatNumber(l.exclusiveMin)}`);
+  if (l.exclusiveMax !== undefined && !(value < l.exclusiveMax))
+    add(`must be < ${formatNumber(l.exclusiveMax)}`);
+  // zod's .int() bounds (±2^53−1) are shown only when crossed.
+  if (typeof s.minimum === "number" && s.minimum <= -SAFE && value < s.minimum)
+    add(`must be ≥ ${s.minimum}`);
+  if (typeof s.maximum === "number" && s.maximum >= SAFE && value > s.maximum)
+    add(`must be ≤ ${s.maximum}`);
+  if (typeof s.multipleOf === "number" && s.multipleOf > 0) {
+    const q = value / s.multipleOf;
+    if (Math.abs(q - Math.round(q)) > 1e-9) add(`must be a multiple of ${s.multipleOf}`);
+  }
+  return issues;
+}
+
+/** A string: length in code points, and pattern (one that does not compile is ignored). */
+function stringIssues(s: JsonSchema, value: string, path: Path): Issue[] {
+  const { issues, add } = collector(path);
+  const n = [...value].length;
+  if (s.minLength !== undefined && n < s.minLength)
+    add(s.minLength === 1 ? "must not be empty" : `must have at least ${s.minLength} characters`);
+  if (s.maxLength !== undefined && n > s.maxLength)
+    add(`must have at most ${s.maxLength} characters`);
+  if (s.pattern !== undefined) {
+    let re: RegExp | undefined;
+    try {
+      re = new RegExp(s.pattern, "u");
+    } catch {
+      re = undefined;
     }
+    if (re && !re.test(value)) add(`must match ${s.pattern}`);
+  }
+  return issues;
+}
+
+/** A list: its length, then each item against its prefixItems / items schema (or missing). */
+function arrayIssues(s: JsonSchema, value: unknown[], root: JsonSchema, path: Path): Issue[] {
+  const { issues, add } = collector(path);
+  if (s.minItems !== undefined && value.length < s.minItems)
+    add(s.minItems === 1 ? "needs at least 1 item" : `needs at least ${s.minItems} items`);
+  if (s.maxItems !== undefined && value.length > s.maxItems)
+    add(`must have at most ${s.maxItems} items`);
+  const prefix = s.prefixItems ?? (Array.isArray(s.items) ? s.items : undefined);
+  value.forEach((item, i) => {
+    const is =
+      prefix && i < prefix.length
+        ? prefix[i]
+        : typeof s.items === "object" && !Array.isArray(s.items)
+          ? s.items
+          : undefined;
+    if (item === undefined) add("item is missing", [...path, i]);
+    else if (is) issues.push(...validate(is, item, root, [...path, i]));
+  });
+  return issues;
+}
+
+/** A mapping: required keys, then each given key's name and value (or that it is unknown). */
+function objectIssues(
+  s: JsonSchema,
+  obj: Record<string, unknown>,
+  root: JsonSchema,
+  path: Path,
+): Issue[] {
+  const { issues, add } = collector(path);
+  const props = s.properties ?? {};
+  for (const k of s.required ?? []) if (obj[k] === undefined) add("required", [...path, k]);
+  for (const [k, v] of Object.entries(obj)) {
+    if (v === undefined) continue;
+    if (s.propertyNames) {
+      const kIssues = validate(s.propertyNames, k, root, [...path, k]);
+      for (const i of kIssues) add(`name '${k}' ${i.message}`, i.path);
+    }
+    if (k in props) issues.push(...validate(props[k], v, root, [...path, k]));
+    else if (s.additionalProperties === false) {
+      const allowed = Object.keys(props);
+      add(`unknown key '${k}'${allowed.length ? ` (allowed: ${allowed.join(", ")})` : ""}`, [
+        ...path,
+        k,
+      ]);
+    } else if (typeof s.additionalProperties === "object")
+      issues.push(...validate(s.additionalProperties, v, root, [...path, k]));
   }
   return issues;
 }
