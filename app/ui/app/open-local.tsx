@@ -51,22 +51,35 @@ function forget(folder: Folder | null): void {
 /** The attribute that makes a file input pick a folder (not in React's types). */
 const DIRECTORY = { webkitdirectory: "" } as Record<string, string>;
 
-export function OpenLocal({
-  inPage,
-  onOpen,
-  notify,
-}: {
+/** A file opened alone that names files next to it: its name and text. */
+interface Need {
+  name: string;
+  text: string;
+}
+
+/** The file asked for (same name; the same text when several have it), else undefined. */
+async function find(f: Folder, want: Need): Promise<string | undefined> {
+  const same = f.pipelines.filter((p) => p.split("/").pop() === want.name);
+  if (same.length <= 1) return same[0];
+  for (const p of same) if ((await f.files.get(p)!.text()) === want.text) return p;
+  return undefined;
+}
+
+interface OpenLocalProps {
   /** The engine runs in this page (it can read what the page hands it). */
   inPage: boolean;
   /** Loads (and starts) a pipeline's text. */
   onOpen(file: string, text: string): Promise<Reply>;
   notify(message: string, level?: "info" | "error"): void;
-}) {
+}
+
+/** OpenLocal's state (the folder asked for, the folder to choose in) and its input handlers. */
+function useOpenLocal({ inPage, onOpen, notify }: OpenLocalProps) {
   const client = useEngine();
   const folderInput = useRef<HTMLInputElement>(null);
   const folder = useRef<Folder | null>(null);
   /** A file opened alone that names files next to it: its folder is asked for. */
-  const [need, setNeed] = useState<{ name: string; text: string } | null>(null);
+  const [need, setNeed] = useState<Need | null>(null);
   const [choose, setChoose] = useState<Folder | null>(null);
   useEffect(() => () => forget(folder.current), []);
 
@@ -90,14 +103,6 @@ export function OpenLocal({
     await onOpen(path, await from.files.get(path)!.text());
   };
 
-  /** The file asked for (same name; the same text when several have it), else undefined. */
-  const find = async (f: Folder, want: { name: string; text: string }) => {
-    const same = f.pipelines.filter((p) => p.split("/").pop() === want.name);
-    if (same.length <= 1) return same[0];
-    for (const p of same) if ((await f.files.get(p)!.text()) === want.text) return p;
-    return undefined;
-  };
-
   const openFolder = async (e: React.ChangeEvent<HTMLInputElement>): Promise<void> => {
     const list = e.target.files;
     if (!list || list.length === 0) return;
@@ -119,31 +124,18 @@ export function OpenLocal({
     else setChoose(f);
   };
 
+  return { folderInput, need, setNeed, choose, setChoose, openFile, openFromFolder, openFolder };
+}
+
+/** _Open file…_, _Open folder…_ (in-page engine) and what they ask: the folder, which pipeline. */
+export function OpenLocal(props: OpenLocalProps) {
+  const { folderInput, need, setNeed, choose, setChoose, openFile, openFromFolder, openFolder } =
+    useOpenLocal(props);
   return (
     <span className="open-local">
-      <label className="button file-open" title="Load a pipeline file from this computer">
-        Open file…
-        <input
-          type="file"
-          accept=".yaml,.yml,text/yaml"
-          className="sr-only"
-          onChange={(e) => void openFile(e)}
-        />
-      </label>
-      {inPage ? (
-        <label
-          className="button folder-open"
-          title="Open a folder of this computer: a pipeline in it and the data files it names"
-        >
-          Open folder…
-          <input
-            ref={folderInput}
-            type="file"
-            {...DIRECTORY}
-            className="sr-only"
-            onChange={(e) => void openFolder(e)}
-          />
-        </label>
+      <OpenFileButton onChange={(e) => void openFile(e)} />
+      {props.inPage ? (
+        <OpenFolderButton inputRef={folderInput} onChange={(e) => void openFolder(e)} />
       ) : null}
       {need ? (
         <NeedFolder
@@ -160,6 +152,38 @@ export function OpenLocal({
         />
       ) : null}
     </span>
+  );
+}
+
+/** What a file input calls when files are picked. */
+type OnInputChange = (e: React.ChangeEvent<HTMLInputElement>) => void;
+
+/** _Open file…_: a button that picks one pipeline file. */
+function OpenFileButton({ onChange }: { onChange: OnInputChange }) {
+  return (
+    <label className="button file-open" title="Load a pipeline file from this computer">
+      Open file…
+      <input type="file" accept=".yaml,.yml,text/yaml" className="sr-only" onChange={onChange} />
+    </label>
+  );
+}
+
+/** _Open folder…_: a button that picks a folder (its input is also clicked by NeedFolder). */
+function OpenFolderButton({
+  inputRef,
+  onChange,
+}: {
+  inputRef: React.RefObject<HTMLInputElement | null>;
+  onChange: OnInputChange;
+}) {
+  return (
+    <label
+      className="button folder-open"
+      title="Open a folder of this computer: a pipeline in it and the data files it names"
+    >
+      Open folder…
+      <input ref={inputRef} type="file" {...DIRECTORY} className="sr-only" onChange={onChange} />
+    </label>
   );
 }
 

@@ -89,41 +89,63 @@ const HOLD = {
     (a.rate === "–") !== (b.rate === "–"),
 };
 
-function BlockNodeComponent({ data }: NodeProps<BlockNodeType>) {
-  const b = data.block;
-  const edit = data.edit;
-  const g = useContext(GraphStateContext);
-  const v = useTelemetrySelector((t) => blockView(t, b.name, g.running), undefined, HOLD);
-  const both = v.status === "lagging" && v.stumbling;
-  const label = statusText(v.status, v.stumbling);
-  const desired =
-    b.desiredRate > 0
-      ? Number.isInteger(b.desiredRate)
-        ? String(b.desiredRate)
-        : formatRate(b.desiredRate)
-      : "–";
-  const open = g.openPanels.has(b.name);
-  const title =
+/** The desired rate as shown: a whole number as it is, else like a rate; "–" when it has none. */
+function desiredRateText(rate: number): string {
+  return rate > 0 ? (Number.isInteger(rate) ? String(rate) : formatRate(rate)) : "–";
+}
+
+/** The node's tooltip: in edit mode name, type and summary; else also status and help. */
+function nodeTitle(b: BlockInfo, v: BlockView, both: boolean, edit: BlockNodeData["edit"]): string {
+  if (edit) return `${b.name} (${b.type})${b.summary ? `\n${b.summary}` : ""}`;
+  return (
     `${b.name} (${b.type}): ${STATUS_HELP[v.status]}` +
     (both ? "; also stumbling" : "") +
     (v.computeMs ? `\ncompute ${v.computeMs} ms per call (mean)` : "") +
     (b.summary ? `\n${b.summary}` : "") +
-    "\nClick or Enter: control panel · right-click or Shift+F10: actions";
+    "\nClick or Enter: control panel · right-click or Shift+F10: actions"
+  );
+}
+
+/** The node's class names: its status and what else shows on it. */
+function nodeClass(
+  v: BlockView,
+  both: boolean,
+  open: boolean,
+  edit: BlockNodeData["edit"],
+): string {
+  return (
+    `block-node status-${v.status}` +
+    (both ? " also-stumbling" : "") +
+    (open ? " panel-open" : "") +
+    (v.errors > 0 ? " has-errors" : "") +
+    (edit ? " is-editing" : "") +
+    (edit && edit.issues.length > 0 ? " has-issues" : "")
+  );
+}
+
+/** The graph state and what the node shows of its block's telemetry. */
+function useBlockNode(b: BlockInfo) {
+  const g = useContext(GraphStateContext);
+  const v = useTelemetrySelector((t) => blockView(t, b.name, g.running), undefined, HOLD);
+  /** Lagging and stumbling at once: both show. */
+  const both = v.status === "lagging" && v.stumbling;
+  return { g, v, both };
+}
+
+/** One block's node: its handles, name and menu, type, status, rate, text and issues. */
+function BlockNodeComponent({ data }: NodeProps<BlockNodeType>) {
+  const b = data.block;
+  const edit = data.edit;
+  const { g, v, both } = useBlockNode(b);
+  const desired = desiredRateText(b.desiredRate);
   return (
     <div
-      className={
-        `block-node status-${v.status}` +
-        (both ? " also-stumbling" : "") +
-        (open ? " panel-open" : "") +
-        (v.errors > 0 ? " has-errors" : "") +
-        (edit ? " is-editing" : "") +
-        (edit && edit.issues.length > 0 ? " has-issues" : "")
-      }
+      className={nodeClass(v, both, g.openPanels.has(b.name), edit)}
       data-block={b.name}
       data-status={v.status}
       data-stumbling={String(v.stumbling)}
       data-issues={edit ? String(edit.issues.length) : undefined}
-      title={edit ? `${b.name} (${b.type})${b.summary ? `\n${b.summary}` : ""}` : title}
+      title={nodeTitle(b, v, both, edit)}
     >
       <Handle
         type="target"
@@ -134,58 +156,17 @@ function BlockNodeComponent({ data }: NodeProps<BlockNodeType>) {
       />
       <div className="block-node__head">
         <span className="block-node__name">{b.name}</span>
-        {edit ? null : (
-          <button
-            type="button"
-            className="block-node__menu nodrag"
-            tabIndex={-1}
-            aria-label={`Actions of ${b.name}`}
-            onClick={(e) => {
-              e.stopPropagation();
-              const r = e.currentTarget.getBoundingClientRect();
-              g.onMenu(b.name, { x: r.left, y: r.bottom + 2 });
-            }}
-          >
-            ⋮
-          </button>
-        )}
+        {edit ? null : <MenuButton name={b.name} onMenu={g.onMenu} />}
       </div>
       <div className="block-node__type">
         {b.type} <ChangedMark block={b} />
       </div>
-      <div className="block-node__status" aria-label={`status: ${label}`}>
-        <span className="block-node__status-item">
-          <StatusIcon status={v.status} />
-          {STATUS_LABEL[v.status]}
-        </span>
-        {both ? (
-          <span className="block-node__status-item is-also">
-            <StatusIcon status="stumbling" />
-            stumbling
-          </span>
-        ) : null}
-      </div>
+      <NodeStatus v={v} both={both} />
       <div className="block-node__rate" aria-label={`rate ${v.rate} of ${desired} hertz`}>
         {v.rate} / {desired} Hz
       </div>
-      {v.text !== "" || v.errors > 0 || v.dropsIn > 0 ? (
-        <div className="block-node__text">
-          {v.errors > 0 ? (
-            <span className="block-node__errors" title={v.lastError}>
-              {v.errors} error{v.errors === 1 ? "" : "s"}
-            </span>
-          ) : null}
-          {v.dropsIn > 0 ? <span className="block-node__drops">{v.dropsIn} dropped</span> : null}
-          <span className="block-node__note">{v.errors > 0 ? v.lastError : v.text}</span>
-        </div>
-      ) : null}
-      {edit && edit.issues.length > 0 ? (
-        <ul className="block-node__issues">
-          {edit.issues.map((m, i) => (
-            <li key={i}>{m}</li>
-          ))}
-        </ul>
-      ) : null}
+      {v.text !== "" || v.errors > 0 || v.dropsIn > 0 ? <NodeText v={v} /> : null}
+      {edit && edit.issues.length > 0 ? <NodeIssues issues={edit.issues} /> : null}
       <Handle
         type="source"
         position={Position.Right}
@@ -193,6 +174,69 @@ function BlockNodeComponent({ data }: NodeProps<BlockNodeType>) {
         aria-label={edit ? `output of ${b.name}` : undefined}
       />
     </div>
+  );
+}
+
+/** ⋮: opens the block's actions below itself (the click does not reach the node). */
+function MenuButton({ name, onMenu }: { name: string; onMenu: GraphState["onMenu"] }) {
+  return (
+    <button
+      type="button"
+      className="block-node__menu nodrag"
+      tabIndex={-1}
+      aria-label={`Actions of ${name}`}
+      onClick={(e) => {
+        e.stopPropagation();
+        const r = e.currentTarget.getBoundingClientRect();
+        onMenu(name, { x: r.left, y: r.bottom + 2 });
+      }}
+    >
+      ⋮
+    </button>
+  );
+}
+
+/** Status: icon and word, and "stumbling" beside it when the block is lagging too. */
+function NodeStatus({ v, both }: { v: BlockView; both: boolean }) {
+  return (
+    <div className="block-node__status" aria-label={`status: ${statusText(v.status, v.stumbling)}`}>
+      <span className="block-node__status-item">
+        <StatusIcon status={v.status} />
+        {STATUS_LABEL[v.status]}
+      </span>
+      {both ? (
+        <span className="block-node__status-item is-also">
+          <StatusIcon status="stumbling" />
+          stumbling
+        </span>
+      ) : null}
+    </div>
+  );
+}
+
+/** Errors (the last one's text), dropped inputs, and the block's one-line text. */
+function NodeText({ v }: { v: BlockView }) {
+  return (
+    <div className="block-node__text">
+      {v.errors > 0 ? (
+        <span className="block-node__errors" title={v.lastError}>
+          {v.errors} error{v.errors === 1 ? "" : "s"}
+        </span>
+      ) : null}
+      {v.dropsIn > 0 ? <span className="block-node__drops">{v.dropsIn} dropped</span> : null}
+      <span className="block-node__note">{v.errors > 0 ? v.lastError : v.text}</span>
+    </div>
+  );
+}
+
+/** Edit mode: the block's problems. */
+function NodeIssues({ issues }: { issues: string[] }) {
+  return (
+    <ul className="block-node__issues">
+      {issues.map((m, i) => (
+        <li key={i}>{m}</li>
+      ))}
+    </ul>
   );
 }
 

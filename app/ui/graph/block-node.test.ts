@@ -1,0 +1,175 @@
+import { ReactFlowProvider } from "@xyflow/react";
+import { createElement, type ComponentType, type Context } from "react";
+import { renderToStaticMarkup } from "react-dom/server";
+import { afterEach, describe, expect, test, vi } from "vitest";
+import type { BlockInfo } from "../../engine/protocol";
+import type { Telemetry } from "../../engine/runtime/runtime";
+import type { EngineClient } from "../client/engine-client";
+import { EngineContext } from "../client/hooks";
+
+/** The props of every DOM element rendered with an onClick (the menu button), in order. */
+const { clicks, capture } = vi.hoisted(() => {
+  const clicks: { onClick(e: unknown): void }[] = [];
+  const capture =
+    (jsx: (...a: unknown[]) => unknown) =>
+    (type: unknown, props: { onClick?: unknown }, ...rest: unknown[]) => {
+      if (typeof type === "string" && props?.onClick)
+        clicks.push(props as { onClick(e: unknown): void });
+      return jsx(type, props, ...rest);
+    };
+  return { clicks, capture };
+});
+vi.mock("react/jsx-dev-runtime", async (orig) => {
+  const m = await orig<typeof import("react/jsx-dev-runtime")>();
+  return { ...m, jsxDEV: capture(m.jsxDEV as (...a: unknown[]) => unknown) };
+});
+vi.mock("react/jsx-runtime", async (orig) => {
+  const m = await orig<typeof import("react/jsx-runtime")>();
+  return {
+    ...m,
+    jsx: capture(m.jsx as (...a: unknown[]) => unknown),
+    jsxs: capture(m.jsxs as (...a: unknown[]) => unknown),
+  };
+});
+afterEach(() => {
+  clicks.length = 0;
+});
+
+/** block-node.tsx's GraphState and node props (the test's tsconfig has no JSX to read it with). */
+interface GraphState {
+  running: boolean;
+  openPanels: ReadonlySet<string>;
+  onMenu(block: string, anchor: { x: number; y: number }): void;
+}
+type NodeProps = { data: { block: BlockInfo; edit?: { issues: string[] } } };
+
+/** Loaded at run time: the tsconfig that checks tests (node) has no JSX to compile the .tsx. */
+const blockNode = "./block-node.tsx";
+const { BlockNode, GraphStateContext } = (await import(blockNode)) as {
+  BlockNode: ComponentType<NodeProps>;
+  GraphStateContext: Context<GraphState>;
+};
+
+const block = (over: Partial<BlockInfo> = {}): BlockInfo =>
+  ({
+    name: "Filter",
+    type: "Bandpass",
+    summary: "",
+    desiredRate: 250,
+    inputs: [{ block: "Src", port: "out" }],
+    live: ["low"],
+    params: { low: 1 },
+    fileParams: { low: 1 },
+    ...over,
+  }) as unknown as BlockInfo;
+
+const stats = (over: Record<string, unknown> = {}) => ({
+  name: "Filter",
+  status: "ontime",
+  stumbling: false,
+  rate: 24.96,
+  text: "",
+  errors: 0,
+  lastError: "",
+  dropsIn: 0,
+  computeMeanMs: 0,
+  ...over,
+});
+
+/** The node's markup for a block, its telemetry, the graph state and the edit data. */
+function render(
+  b: BlockInfo,
+  opts: {
+    telemetry?: Record<string, unknown>;
+    running?: boolean;
+    open?: boolean;
+    edit?: { issues: string[] };
+    onMenu?: GraphState["onMenu"];
+  } = {},
+): string {
+  const telemetry = opts.telemetry
+    ? ({ blocks: [opts.telemetry] } as unknown as Telemetry)
+    : undefined;
+  const client = {
+    telemetry,
+    graph: undefined,
+    onTelemetry: () => () => {},
+    onParams: () => () => {},
+  } as unknown as EngineClient;
+  const graph = {
+    running: opts.running ?? true,
+    openPanels: new Set(opts.open ? [b.name] : []),
+    onMenu: opts.onMenu ?? (() => {}),
+  };
+  const props: NodeProps = { data: { block: b, edit: opts.edit } };
+  return renderToStaticMarkup(
+    createElement(
+      ReactFlowProvider,
+      null,
+      createElement(
+        EngineContext.Provider,
+        { value: client },
+        createElement(
+          GraphStateContext.Provider,
+          { value: graph },
+          createElement(BlockNode, props),
+        ),
+      ),
+    ),
+  );
+}
+
+describe("BlockNode markup", () => {
+  test("no telemetry: idle, no rate, no text", () => {
+    expect(render(block({ inputs: [] }))).toMatchSnapshot();
+  });
+  test("running, on time, a fractional desired rate, compute time and a summary", () => {
+    const html = render(block({ desiredRate: 12.5, summary: "keeps 1–40 Hz" }), {
+      telemetry: stats({ computeMeanMs: 0.01234 }),
+      open: true,
+    });
+    expect(html).toContain('class="block-node status-ontime panel-open"');
+    expect(html).toMatchSnapshot();
+  });
+  test("lagging and stumbling, errors, drops, a changed live value", () => {
+    const html = render(block({ params: { low: 2 } }), {
+      telemetry: stats({
+        status: "lagging",
+        stumbling: true,
+        text: "t",
+        errors: 2,
+        lastError: "boom",
+        dropsIn: 3,
+      }),
+    });
+    expect(html).toContain("also-stumbling has-errors");
+    expect(html).toContain("2 errors");
+    expect(html).toMatchSnapshot();
+  });
+  test("one error, text only, not running", () => {
+    expect(
+      render(block(), {
+        telemetry: stats({ status: "lagging", text: "note", errors: 1, lastError: "e" }),
+        running: false,
+      }),
+    ).toMatchSnapshot();
+  });
+  test("edit mode with and without issues", () => {
+    expect(render(block({ summary: "s" }), { edit: { issues: ["a", "b"] } })).toMatchSnapshot();
+    expect(render(block(), { edit: { issues: [] }, telemetry: stats() })).toMatchSnapshot();
+  });
+  test("the menu button opens the block's actions below itself, and the click stops there", () => {
+    const log: unknown[] = [];
+    render(block(), { onMenu: (name, at) => log.push(["menu", name, at]) });
+    expect(clicks).toHaveLength(1);
+    clicks[0]!.onClick({
+      stopPropagation: () => log.push(["stop"]),
+      currentTarget: { getBoundingClientRect: () => ({ left: 10, bottom: 40 }) },
+    });
+    expect(log).toEqual([["stop"], ["menu", "Filter", { x: 10, y: 42 }]]);
+  });
+  test("in edit mode there is no menu button", () => {
+    render(block(), { edit: { issues: [] } });
+    expect(clicks).toHaveLength(0);
+  });
+});
