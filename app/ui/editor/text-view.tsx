@@ -21,7 +21,7 @@ import {
   setDiagnostics,
   type Diagnostic as LintDiagnostic,
 } from "@codemirror/lint";
-import { Annotation, EditorState } from "@codemirror/state";
+import { Annotation, EditorState, type Extension } from "@codemirror/state";
 import {
   EditorView,
   highlightActiveLine,
@@ -29,7 +29,7 @@ import {
   keymap,
   lineNumbers,
 } from "@codemirror/view";
-import { useEffect, useRef, type ReactNode } from "react";
+import { useEffect, useRef, type ReactNode, type RefObject } from "react";
 import type { CatalogInfo } from "../../engine/protocol";
 import { completeAt } from "./completion";
 import type { EditIssue } from "./model";
@@ -61,87 +61,112 @@ function lintOf(state: EditorState, issues: readonly EditIssue[]): LintDiagnosti
     });
 }
 
-export function TextView({ text, issues, catalog, onChange }: TextViewProps): ReactNode {
-  const host = useRef<HTMLDivElement>(null);
-  const view = useRef<EditorView | null>(null);
-  const latest = useRef({ issues, catalog, onChange });
-  latest.current = { issues, catalog, onChange };
+/** What the editor's extensions read when they run: the props of the latest render. */
+type Latest = RefObject<Pick<TextViewProps, "issues" | "catalog" | "onChange">>;
 
+/** The view's extensions: YAML, completion and lint from `latest`, typing reported to `onChange`. */
+function extensionsOf(latest: Latest): Extension[] {
+  return [
+    lineNumbers(),
+    highlightActiveLineGutter(),
+    highlightActiveLine(),
+    yaml(),
+    syntaxHighlighting(defaultHighlightStyle, { fallback: true }),
+    autocompletion({
+      override: [
+        (ctx: CompletionContext): CompletionResult | null =>
+          completeAt(ctx.state.doc.toString(), ctx.pos, latest.current.catalog),
+      ],
+    }),
+    linter((ev): LintDiagnostic[] => lintOf(ev.state, latest.current.issues), {
+      delay: 150,
+    }),
+    lintGutter(),
+    keymap.of([...defaultKeymap, indentWithTab]),
+    // Long lines wrap: the pane is narrow and never scrolls sideways (issue 17, defect 8).
+    EditorView.lineWrapping,
+    EditorView.contentAttributes.of({ "aria-label": "Pipeline YAML" }),
+    EditorView.updateListener.of((u) => {
+      if (!u.docChanged || u.transactions.some((t) => t.annotation(External))) return;
+      latest.current.onChange(u.state.doc.toString());
+    }),
+  ];
+}
+
+/** Creates the CodeMirror view in `host` once (with the first text), destroyed on unmount. */
+function useCodeMirrorView(
+  host: RefObject<HTMLDivElement | null>,
+  view: RefObject<EditorView | null>,
+  text: string,
+  latest: Latest,
+): void {
   useEffect(() => {
     const el = host.current;
     if (!el) return undefined;
     const v = new EditorView({
       parent: el,
-      state: EditorState.create({
-        doc: text,
-        extensions: [
-          lineNumbers(),
-          highlightActiveLineGutter(),
-          highlightActiveLine(),
-          yaml(),
-          syntaxHighlighting(defaultHighlightStyle, { fallback: true }),
-          autocompletion({
-            override: [
-              (ctx: CompletionContext): CompletionResult | null =>
-                completeAt(ctx.state.doc.toString(), ctx.pos, latest.current.catalog),
-            ],
-          }),
-          linter((ev): LintDiagnostic[] => lintOf(ev.state, latest.current.issues), {
-            delay: 150,
-          }),
-          lintGutter(),
-          keymap.of([...defaultKeymap, indentWithTab]),
-          // Long lines wrap: the pane is narrow and never scrolls sideways (issue 17, defect 8).
-          EditorView.lineWrapping,
-          EditorView.contentAttributes.of({ "aria-label": "Pipeline YAML" }),
-          EditorView.updateListener.of((u) => {
-            if (!u.docChanged || u.transactions.some((t) => t.annotation(External))) return;
-            latest.current.onChange(u.state.doc.toString());
-          }),
-        ],
-      }),
+      state: EditorState.create({ doc: text, extensions: extensionsOf(latest) }),
     });
     view.current = v;
     return () => {
       v.destroy();
       view.current = null;
     };
-    // Created once (with the first text); later texts follow in the effect below.
+    // Created once (with the first text); later texts follow in useExternalText.
   }, []);
+}
 
-  // A text from elsewhere (a canvas edit, undo, a template): replace what differs.
+/** The change that turns `old` into `text`: the span between their common prefix and suffix. */
+function differingSpan(old: string, text: string): { from: number; to: number; insert: string } {
+  let start = 0;
+  while (start < old.length && start < text.length && old[start] === text[start]) start++;
+  let endOld = old.length;
+  let endNew = text.length;
+  while (endOld > start && endNew > start && old[endOld - 1] === text[endNew - 1]) {
+    endOld--;
+    endNew--;
+  }
+  return { from: start, to: endOld, insert: text.slice(start, endNew) };
+}
+
+/** A text from elsewhere (a canvas edit, undo, a template): replace what differs. */
+function useExternalText(view: RefObject<EditorView | null>, text: string): void {
   useEffect(() => {
     const v = view.current;
     if (!v) return;
     const old = v.state.doc.toString();
     if (old === text) return;
-    let start = 0;
-    while (start < old.length && start < text.length && old[start] === text[start]) start++;
-    let endOld = old.length;
-    let endNew = text.length;
-    while (endOld > start && endNew > start && old[endOld - 1] === text[endNew - 1]) {
-      endOld--;
-      endNew--;
-    }
-    v.dispatch({
-      changes: { from: start, to: endOld, insert: text.slice(start, endNew) },
-      annotations: External.of(true),
-    });
+    v.dispatch({ changes: differingSpan(old, text), annotations: External.of(true) });
   }, [text]);
+}
 
-  // The engine's answer comes after the text changed: shown when it arrives.
+/** The engine's answer comes after the text changed: shown when it arrives. */
+function useIssueDiagnostics(view: RefObject<EditorView | null>, issues: readonly EditIssue[]) {
   useEffect(() => {
     const v = view.current;
     if (v) v.dispatch(setDiagnostics(v.state, lintOf(v.state, issues)));
   }, [issues]);
+}
 
-  const goTo = (line: number, col: number): void => {
-    const v = view.current;
-    if (!v || line < 1) return;
-    const { from } = lineOffset(v.state, line, col);
-    v.dispatch({ selection: { anchor: from }, scrollIntoView: true });
-    v.focus();
-  };
+/** Puts the cursor at a line and column, scrolled into view and focused. */
+function goToPosition(v: EditorView | null, line: number, col: number): void {
+  if (!v || line < 1) return;
+  const { from } = lineOffset(v.state, line, col);
+  v.dispatch({ selection: { anchor: from }, scrollIntoView: true });
+  v.focus();
+}
+
+/** The pipeline's text in a CodeMirror view, with its problems listed under it. */
+export function TextView({ text, issues, catalog, onChange }: TextViewProps): ReactNode {
+  const host = useRef<HTMLDivElement>(null);
+  const view = useRef<EditorView | null>(null);
+  const latest = useRef({ issues, catalog, onChange });
+  latest.current = { issues, catalog, onChange };
+  useCodeMirrorView(host, view, text, latest);
+  useExternalText(view, text);
+  useIssueDiagnostics(view, issues);
+
+  const goTo = (line: number, col: number): void => goToPosition(view.current, line, col);
 
   return (
     <section className="text-view" aria-label="Pipeline text (YAML)">

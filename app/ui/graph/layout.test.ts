@@ -1,5 +1,11 @@
 import { describe, expect, it } from "vitest";
-import { acyclicEdges, countCrossings, layeredLayout, longestPathLayers } from "./layout";
+import {
+  acyclicEdges,
+  countCrossings,
+  layeredLayout,
+  longestPathLayers,
+  type Placed,
+} from "./layout";
 
 const opts = { nodeWidth: 100, nodeHeight: 50, gapX: 50, gapY: 10 };
 
@@ -137,6 +143,63 @@ describe("layeredLayout", () => {
       }
     }
     expect(layeredLayout(nodes, edges, opts)).toEqual(pos);
+  });
+
+  it("places exact coordinates: dummies take half a lane, layers are centred, first name wins", () => {
+    // T→D spans four layers (three dummies); "A" is listed twice (the second is an isolated
+    // node whose position the first "A" overwrites); "X" is unknown; E→E is a self loop.
+    const nodes = ["T", "A", "B", "C", "D", "E", "A", "Solo"];
+    const edges: [string, string][] = [
+      ["T", "A"],
+      ["T", "E"],
+      ["A", "B"],
+      ["B", "C"],
+      ["C", "D"],
+      ["T", "D"],
+      ["E", "B"],
+      ["E", "E"],
+      ["D", "A"],
+      ["X", "A"],
+    ];
+    const pos = layeredLayout(nodes, edges, opts);
+    expect([...pos]).toEqual([
+      ["T", { x: 0, y: 0, layer: 0, order: 0 }],
+      ["A", { x: 150, y: 15, layer: 1, order: 0 }],
+      ["Solo", { x: 0, y: 120, layer: 0, order: 2 }],
+      ["E", { x: 150, y: 75, layer: 1, order: 1 }],
+      ["B", { x: 300, y: 45, layer: 2, order: 0 }],
+      ["C", { x: 450, y: 45, layer: 3, order: 0 }],
+      ["D", { x: 600, y: 60, layer: 4, order: 0 }],
+    ]);
+  });
+
+  it("keeps the initial depth-first order with no sweeps and improves it with sweeps", () => {
+    const nodes = ["n0", "n1", "n2", "n3", "n4", "n5"];
+    const edges: [string, string][] = [
+      ["n2", "n4"],
+      ["n0", "n2"],
+      ["n2", "n3"],
+      ["n0", "n4"],
+    ];
+    const col = (p: Map<string, Placed>) => [...p].map(([k, v]) => [k, v.layer, v.order, v.y]);
+    expect(col(layeredLayout(nodes, edges, { sweeps: 0 }))).toEqual([
+      ["n0", 0, 0, 0],
+      ["n1", 0, 1, 120],
+      ["n5", 0, 2, 240],
+      ["n2", 1, 0, 90],
+      ["n4", 2, 0, 60],
+      ["n3", 2, 1, 180],
+    ]);
+    const swept = layeredLayout(nodes, edges);
+    expect(col(swept)).toEqual([
+      ["n0", 0, 0, 0],
+      ["n1", 0, 1, 120],
+      ["n5", 0, 2, 240],
+      ["n2", 1, 0, 90],
+      ["n3", 2, 0, 60],
+      ["n4", 2, 1, 180],
+    ]);
+    expect(swept.get("n3")!.x).toBe(2 * (184 + 64));
   });
 
   it("handles an empty graph", () => {

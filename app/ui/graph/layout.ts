@@ -135,31 +135,24 @@ export function countCrossings(
   return c;
 }
 
-/**
- * Lays out `nodes` (names, in file order) connected by `edges`. Returns the top-left corner of
- * every node's box.
- */
-export function layeredLayout(
-  nodes: readonly string[],
-  edges: readonly LayoutEdge[],
-  options: Partial<LayoutOptions> = {},
-): Map<string, Placed> {
-  const o = { ...DEFAULT_LAYOUT, ...options };
+/** Node indices of the edges between known, distinct names (the first index of a repeated name). */
+function indexEdges(nodes: readonly string[], edges: readonly LayoutEdge[]): [number, number][] {
   const index = new Map<string, number>();
   nodes.forEach((name, i) => {
     if (!index.has(name)) index.set(name, i);
   });
-  const real = nodes.length;
   const pairs: [number, number][] = [];
   for (const [a, b] of edges) {
     const i = index.get(a);
     const j = index.get(b);
     if (i !== undefined && j !== undefined && i !== j) pairs.push([i, j]);
   }
-  const dag = acyclicEdges(real, pairs);
-  const layerOf = longestPathLayers(dag);
+  return pairs;
+}
 
-  // Proper layering: split long edges with dummy nodes (indices ≥ real).
+/** Splits long edges: one dummy node per crossed layer (indices ≥ real, pushed to `layerOf`). */
+function splitLongEdges(dag: Graph, layerOf: number[]): { succ: number[][]; pred: number[][] } {
+  const real = dag.n;
   const succ: number[][] = dag.succ.map(() => []);
   const pred: number[][] = dag.succ.map(() => []);
   const link = (a: number, b: number): void => {
@@ -180,11 +173,19 @@ export function layeredLayout(
       link(prev, w);
     }
   }
+  return { succ, pred };
+}
+
+/** Initial order: depth-first from the sources in file order, so chains stay together. */
+function initialOrder(
+  real: number,
+  layerOf: readonly number[],
+  succ: readonly (readonly number[])[],
+  pred: readonly (readonly number[])[],
+): number[][] {
   const total = layerOf.length;
   const depth = total === 0 ? 0 : Math.max(...layerOf) + 1;
   const layers: number[][] = Array.from({ length: depth }, () => []);
-
-  // Initial order: depth-first from the sources in file order, so chains stay together.
   const seen = new Uint8Array(total);
   const visit = (v: number): void => {
     const stack = [v];
@@ -198,44 +199,71 @@ export function layeredLayout(
   };
   for (let v = 0; v < real; v++) if (pred[v]!.length === 0) visit(v);
   for (let v = 0; v < total; v++) visit(v);
+  return layers;
+}
 
-  const crossings = (ls: number[][]): number => {
-    let c = 0;
-    for (let l = 0; l + 1 < ls.length; l++) c += countCrossings(ls[l]!, ls[l + 1]!, succ);
-    return c;
-  };
-  const reorder = (ls: number[][], l: number, nbrs: number[][], ref: number[]): void => {
-    const pos = new Map<number, number>();
-    ref.forEach((v, i) => pos.set(v, i));
-    const cur = ls[l]!;
-    const keyed = cur.map((v, i) => {
-      const ps = nbrs[v]!.map((w) => pos.get(w)).filter((p): p is number => p !== undefined);
-      // Nodes without neighbours there keep their place.
-      const bc = ps.length > 0 ? ps.reduce((a, b) => a + b, 0) / ps.length : i;
-      return { v, bc, i };
-    });
-    keyed.sort((a, b) => a.bc - b.bc || a.i - b.i);
-    ls[l] = keyed.map((k) => k.v);
-  };
+/** Crossings summed over every pair of adjacent layers. */
+function totalCrossings(ls: readonly number[][], succ: readonly (readonly number[])[]): number {
+  let c = 0;
+  for (let l = 0; l + 1 < ls.length; l++) c += countCrossings(ls[l]!, ls[l + 1]!, succ);
+  return c;
+}
+
+/** Sorts layer `l` by the barycenter of each node's neighbours (`nbrs`) in the `ref` order. */
+function reorderByBarycenter(
+  ls: number[][],
+  l: number,
+  nbrs: readonly (readonly number[])[],
+  ref: readonly number[],
+): void {
+  const pos = new Map<number, number>();
+  ref.forEach((v, i) => pos.set(v, i));
+  const cur = ls[l]!;
+  const keyed = cur.map((v, i) => {
+    const ps = nbrs[v]!.map((w) => pos.get(w)).filter((p): p is number => p !== undefined);
+    // Nodes without neighbours there keep their place.
+    const bc = ps.length > 0 ? ps.reduce((a, b) => a + b, 0) / ps.length : i;
+    return { v, bc, i };
+  });
+  keyed.sort((a, b) => a.bc - b.bc || a.i - b.i);
+  ls[l] = keyed.map((k) => k.v);
+}
+
+/** Crossing reduction: alternating down and up sweeps; the order with the fewest crossings wins. */
+function reduceCrossings(
+  layers: readonly number[][],
+  succ: readonly (readonly number[])[],
+  pred: readonly (readonly number[])[],
+  sweeps: number,
+): number[][] {
+  const depth = layers.length;
   let best = layers.map((l) => [...l]);
-  let bestC = crossings(best);
+  let bestC = totalCrossings(best, succ);
   const work = layers.map((l) => [...l]);
-  for (let s = 0; s < o.sweeps && bestC > 0; s++) {
-    for (let l = 1; l < depth; l++) reorder(work, l, pred, work[l - 1]!);
-    let c = crossings(work);
+  for (let s = 0; s < sweeps && bestC > 0; s++) {
+    for (let l = 1; l < depth; l++) reorderByBarycenter(work, l, pred, work[l - 1]!);
+    let c = totalCrossings(work, succ);
     if (c < bestC) {
       bestC = c;
       best = work.map((l) => [...l]);
     }
-    for (let l = depth - 2; l >= 0; l--) reorder(work, l, succ, work[l + 1]!);
-    c = crossings(work);
+    for (let l = depth - 2; l >= 0; l--) reorderByBarycenter(work, l, succ, work[l + 1]!);
+    c = totalCrossings(work, succ);
     if (c < bestC) {
       bestC = c;
       best = work.map((l) => [...l]);
     }
   }
+  return best;
+}
 
-  // Coordinates. Dummies take a lane but only half a node's height.
+/** Coordinates: x by layer, y by lane, each layer centred; a dummy lane is half a node's height. */
+function placeCoordinates(
+  best: readonly (readonly number[])[],
+  nodes: readonly string[],
+  o: LayoutOptions,
+): Map<string, Placed> {
+  const real = nodes.length;
   const pitch = o.nodeHeight + o.gapY;
   const heightOf = (v: number): number => (v < real ? pitch : pitch / 2);
   const columnHeight = best.map((l) => l.reduce((a, v) => a + heightOf(v), 0));
@@ -251,4 +279,23 @@ export function layeredLayout(
     });
   });
   return out;
+}
+
+/**
+ * Lays out `nodes` (names, in file order) connected by `edges`. Returns the top-left corner of
+ * every node's box.
+ */
+export function layeredLayout(
+  nodes: readonly string[],
+  edges: readonly LayoutEdge[],
+  options: Partial<LayoutOptions> = {},
+): Map<string, Placed> {
+  const o = { ...DEFAULT_LAYOUT, ...options };
+  const real = nodes.length;
+  const dag = acyclicEdges(real, indexEdges(nodes, edges));
+  const layerOf = longestPathLayers(dag);
+  const { succ, pred } = splitLongEdges(dag, layerOf);
+  const layers = initialOrder(real, layerOf, succ, pred);
+  const best = reduceCrossings(layers, succ, pred, o.sweeps);
+  return placeCoordinates(best, nodes, o);
 }
