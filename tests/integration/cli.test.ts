@@ -60,12 +60,25 @@ describe("mosaic run", () => {
       blocks: { name: string; status: string; rate: number; desiredRate: number }[];
     };
     expect(summary.reason).toBe("duration");
-    // Status at the last telemetry before stopping (the summary is taken after the stop).
-    const tel = lines.filter((l) => l.type === "telemetry").at(-1) as unknown as typeof summary;
-    const bad = tel.blocks
-      .filter((b) => b.status !== "ontime")
-      .map((b) => `${b.name}: ${b.status} ${b.rate}/${b.desiredRate}`);
+    // Every block on time in nearly every report after the first second. This file runs beside
+    // other test files on two cores: one stall of a neighbour makes a batch late, and a late batch
+    // shows as "lagging" for at least 100 ms, so a single report (the last one, as this test read
+    // before) can catch it. A block that is really slow lags in most reports.
+    type Report = typeof summary & { t: number };
+    const reports = lines.filter((l) => l.type === "telemetry") as unknown as Report[];
+    const settled = reports.filter((r) => r.t >= reports[0]!.t + 1);
+    expect(settled.length).toBeGreaterThan(50);
+    const notOnTime = new Map<string, number>();
+    for (const r of settled) {
+      for (const b of r.blocks) {
+        if (b.status !== "ontime") notOnTime.set(b.name, (notOnTime.get(b.name) ?? 0) + 1);
+      }
+    }
+    const bad = [...notOnTime]
+      .filter(([, n]) => n > 0.1 * settled.length)
+      .map(([name, n]) => `${name}: not on time in ${n} of ${settled.length} reports`);
     expect(bad).toEqual([]);
+    const tel = settled.at(-1)!;
     expect(tel.blocks.length).toBe(9);
   });
 
