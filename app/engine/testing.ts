@@ -186,19 +186,10 @@ export class BlockHarness {
     return h;
   }
 
+  /** The BlockContext the block is created with: its inputs, clock, outputs, timers and reports. */
   private context(): BlockContext {
     const h = this;
-    const inputs: InputInfo[] = (this.opts.inputs ?? []).map((i, index) => ({
-      index,
-      source: `in${index}`,
-      block: `in${index}`,
-      port: "out",
-      ...(i.type === undefined ? {} : { type: i.type }),
-      shape: i.shape,
-      rate: i.rate ?? 0,
-      isTimer: i.isTimer ?? false,
-      subscribed: i.subscribed ?? true,
-    }));
+    const inputs = harnessInputs(this.opts);
     return {
       name: "block",
       type: this.def.type,
@@ -216,88 +207,13 @@ export class BlockHarness {
       resources: this.opts.resources ?? noResources,
       io: this.opts.io ?? {},
       output(shape: Shape, port?: string, meta?: PortMeta): OutputPort {
-        const name = port ?? "out";
-        const problem = meta && portMetaProblem(meta, shape.rows * shape.cols);
-        if (problem) throw new Error(`output '${name}': ${problem}`);
-        if (meta) h.metas.set(name, meta);
-        const pool = new FramePool(shape);
-        const rec: Recorded = { t: [], v: [], frames: [] };
-        h.out.set(name, rec);
-        const p: OutputPort = {
-          name,
-          shape,
-          idle: false,
-          frame: (n: number) => pool.take(n),
-          emit: (f: Frame) => {
-            record(rec, f);
-            pool.release(f);
-          },
-        };
-        h.ports.push(p);
-        return p;
+        return harnessOutput(h, shape, port, meta);
       },
       batching: this.opts.batchingS ?? 0,
       every(hz: number, tick: TickCallback, options?: { catchUp?: CatchUp }): TimerHandle {
-        const entry = {
-          hz,
-          tick,
-          running: false,
-          fired: 0,
-          missed: 0,
-          catchUp: options?.catchUp ?? "all",
-        };
-        h.timers.push(entry);
-        return {
-          start: () => {
-            entry.running = true;
-          },
-          stop: () => {
-            entry.running = false;
-          },
-          get running() {
-            return entry.running;
-          },
-          get fired() {
-            return entry.fired;
-          },
-          get missed() {
-            return entry.missed;
-          },
-          setRate: (r: number) => {
-            entry.hz = r;
-          },
-        };
+        return harnessTimer(h, hz, tick, options);
       },
-      at(t: number, fn: (t: number) => void) {
-        h.oneShot = { t, fn };
-      },
-      setText(text: string) {
-        h.text = text;
-      },
-      warn(message: string) {
-        h.warnings.push(message);
-      },
-      error(message: string, detail?: string) {
-        h.errors.push(detail ? `${message}\n${detail}` : message);
-      },
-      setAwaiting(count: number) {
-        h.awaiting = count;
-      },
-      reportCompute(ms: number, budgetMs?: number) {
-        h.computeReports.push({ ms, ...(budgetMs === undefined ? {} : { budgetMs }) });
-      },
-      finish() {
-        h.finished = true;
-      },
-      setSubscribed(index: number, subscribed: boolean) {
-        const i = inputs[index];
-        if (!i) return false;
-        h.subscribed[index] = subscribed;
-        return true;
-      },
-      openLog(path: string, stream: string) {
-        return h.logs.open(stream, "out", true, path);
-      },
+      ...harnessReports(h, inputs),
     };
   }
 
@@ -348,4 +264,130 @@ export class BlockHarness {
       r.frames.length = 0;
     }
   }
+}
+
+/** The inputs a harnessed block is told about, from `HarnessOptions.inputs`. */
+function harnessInputs(opts: HarnessOptions): InputInfo[] {
+  return (opts.inputs ?? []).map((i, index) => ({
+    index,
+    source: `in${index}`,
+    block: `in${index}`,
+    port: "out",
+    ...(i.type === undefined ? {} : { type: i.type }),
+    shape: i.shape,
+    rate: i.rate ?? 0,
+    isTimer: i.isTimer ?? false,
+    subscribed: i.subscribed ?? true,
+  }));
+}
+
+/** `ctx.output` of a harnessed block: a port whose frames are recorded into `h.out`. */
+function harnessOutput(h: BlockHarness, shape: Shape, port?: string, meta?: PortMeta): OutputPort {
+  const name = port ?? "out";
+  const problem = meta && portMetaProblem(meta, shape.rows * shape.cols);
+  if (problem) throw new Error(`output '${name}': ${problem}`);
+  if (meta) h.metas.set(name, meta);
+  const pool = new FramePool(shape);
+  const rec: Recorded = { t: [], v: [], frames: [] };
+  h.out.set(name, rec);
+  const p: OutputPort = {
+    name,
+    shape,
+    idle: false,
+    frame: (n: number) => pool.take(n),
+    emit: (f: Frame) => {
+      record(rec, f);
+      pool.release(f);
+    },
+  };
+  h.ports.push(p);
+  return p;
+}
+
+/** `ctx.every` of a harnessed block: a timer in `h.timers`, fired by `tick` while running. */
+function harnessTimer(
+  h: BlockHarness,
+  hz: number,
+  tick: TickCallback,
+  options?: { catchUp?: CatchUp },
+): TimerHandle {
+  const entry = {
+    hz,
+    tick,
+    running: false,
+    fired: 0,
+    missed: 0,
+    catchUp: options?.catchUp ?? "all",
+  };
+  h.timers.push(entry);
+  return {
+    start: () => {
+      entry.running = true;
+    },
+    stop: () => {
+      entry.running = false;
+    },
+    get running() {
+      return entry.running;
+    },
+    get fired() {
+      return entry.fired;
+    },
+    get missed() {
+      return entry.missed;
+    },
+    setRate: (r: number) => {
+      entry.hz = r;
+    },
+  };
+}
+
+/** The rest of a harnessed block's context: one-shots, and what it reports (kept in `h`). */
+function harnessReports(
+  h: BlockHarness,
+  inputs: readonly InputInfo[],
+): Pick<
+  BlockContext,
+  | "at"
+  | "setText"
+  | "warn"
+  | "error"
+  | "setAwaiting"
+  | "reportCompute"
+  | "finish"
+  | "setSubscribed"
+  | "openLog"
+> {
+  return {
+    at(t: number, fn: (t: number) => void) {
+      h.oneShot = { t, fn };
+    },
+    setText(text: string) {
+      h.text = text;
+    },
+    warn(message: string) {
+      h.warnings.push(message);
+    },
+    error(message: string, detail?: string) {
+      h.errors.push(detail ? `${message}\n${detail}` : message);
+    },
+    setAwaiting(count: number) {
+      h.awaiting = count;
+    },
+    reportCompute(ms: number, budgetMs?: number) {
+      h.computeReports.push({ ms, ...(budgetMs === undefined ? {} : { budgetMs }) });
+    },
+    finish() {
+      h.finished = true;
+    },
+    setSubscribed(index: number, subscribed: boolean) {
+      const i = inputs[index];
+      if (!i) return false;
+      h.subscribed[index] = subscribed;
+      return true;
+    },
+    openLog(path: string, stream: string) {
+      return h.logs.open(stream, "out", true, path);
+    },
+  };
 }

@@ -160,109 +160,144 @@ export interface ParamsResult {
 
 /** Stage 4 for one block: convert, validate, resolve the output ports. */
 export function readParams(c: Collector, p: ParamsInput): ParamsResult {
+  const knownKeys = objectKeys(p.def.params);
+  const read = rawParams(c, p, knownKeys);
+  if (!read) return failed(undefined);
+  const r = p.def.params.safeParse(read.raw, { reportInput: true });
+  if (!r.success) {
+    for (const issue of r.error.issues) reportIssue(c, p, issue, knownKeys, read.legacy);
+    return failed(undefined);
+  }
+  return withOutputs(c, p, r.data, read.legacy ? read.raw : undefined);
+}
+
+/** The result of a block whose Params failed (its outputs: the default port). */
+function failed(converted: unknown): ParamsResult {
+  return { ok: false, params: undefined, converted, outputs: ["out"] };
+}
+
+/** What is validated: the Params as JS, and whether they were converted from the positional form. */
+interface RawParams {
+  raw: unknown;
+  legacy: boolean;
+}
+
+/** The Params to validate, or undefined once an error is reported (they are not a mapping). */
+function rawParams(
+  c: Collector,
+  p: ParamsInput,
+  knownKeys: string[] | undefined,
+): RawParams | undefined {
   const { block, def, node, pos } = p;
-  const type = def.type;
-  const knownKeys = objectKeys(def.params);
-  const fail: ParamsResult = {
-    ok: false,
-    params: undefined,
-    converted: undefined,
-    outputs: ["out"],
-  };
-  let raw: unknown = {};
-  let legacy = false;
-  if (p.args !== undefined) {
-    if (!def.legacyParams) {
-      c.error(
-        "legacy-unsupported",
-        pos,
-        `block '${block}' (${type}): Params is a positional list, but ${type} has no positional form`,
-        {
-          block,
-          expected: `named params: a mapping with ${knownKeys && knownKeys.length ? knownKeys.join(", ") : "no keys"}`,
-        },
-      );
-      return fail;
-    }
-    const args = p.args;
-    const positional = args.length === 1 && args[0] === "" ? [] : args;
+  if (p.args !== undefined) return convertPositional(c, p, p.args, knownKeys);
+  if (isNullish(node)) return { raw: {}, legacy: false };
+  if (isMap(node)) {
     try {
-      raw = def.legacyParams(positional);
-      legacy = true;
-    } catch (e) {
-      c.error(
-        "legacy-params",
-        pos,
-        `block '${block}' (${type}): cannot convert positional Params [${args.join(", ")}]: ${errorMessage(e)}`,
-        {
-          block,
-          ...(e instanceof LegacyParamsError && e.param ? { param: e.param } : {}),
-          ...(def.legacyForm ? { expected: def.legacyForm } : {}),
-        },
-      );
-      return fail;
-    }
-  } else if (isNullish(node)) {
-    raw = {};
-  } else if (isMap(node)) {
-    try {
-      raw = node.toJS(p.doc);
+      return { raw: node.toJS(p.doc), legacy: false };
     } catch (e) {
       c.error("bad-params", pos, `block '${block}': cannot read Params: ${errorMessage(e)}`, {
         block,
       });
-      return fail;
+      return undefined;
     }
-  } else {
-    c.error("bad-params", pos, `block '${block}' (${type}): Params is ${describeNode(node)}`, {
-      block,
-      expected: `a mapping${knownKeys && knownKeys.length ? ` with ${knownKeys.join(", ")}` : ""}${def.legacyParams ? ", or MOSAIC's positional list" : ""}`,
-    });
-    return fail;
   }
+  c.error("bad-params", pos, `block '${block}' (${def.type}): Params is ${describeNode(node)}`, {
+    block,
+    expected: `a mapping${knownKeys && knownKeys.length ? ` with ${knownKeys.join(", ")}` : ""}${def.legacyParams ? ", or MOSAIC's positional list" : ""}`,
+  });
+  return undefined;
+}
 
-  const r = def.params.safeParse(raw, { reportInput: true });
-  if (!r.success) {
-    for (const issue of r.error.issues) {
-      const path = pathText(issue.path);
-      const at = legacy ? undefined : nodeAtPath(node, issue.path);
-      const where = at ? c.pos(at) : pos;
-      const ex = explainIssue(issue, knownKeys);
-      const subject = path === "" ? "Params" : `param '${path}'`;
-      const unknownKey = issue.code === "unrecognized_keys";
-      let kpos = where;
-      if (unknownKey && isMap(node) && !legacy) {
-        const k = issue.keys[0];
-        const kp = node.items.find((it) => scalarString(it.key) === k);
-        if (kp) kpos = c.pos(kp.key as YamlNode);
-      }
-      const message = unknownKey
-        ? `block '${block}' (${type}): ${ex.message}`
-        : `block '${block}' (${type}): ${subject} ${ex.message}`;
-      c.error(
-        "bad-param",
-        kpos,
-        message + (legacy ? " (after converting the positional Params)" : ""),
-        {
-          block,
-          ...(path !== "" ? { param: path } : {}),
-          ...(ex.expected !== undefined ? { expected: ex.expected } : {}),
-          ...(ex.suggestion !== undefined ? { suggestion: ex.suggestion } : {}),
-        },
-      );
-    }
-    return fail;
+/** MOSAIC's positional form converted by the block's `legacyParams` (undefined: an error reported). */
+function convertPositional(
+  c: Collector,
+  p: ParamsInput,
+  args: readonly string[],
+  knownKeys: string[] | undefined,
+): RawParams | undefined {
+  const { block, def, pos } = p;
+  const type = def.type;
+  if (!def.legacyParams) {
+    c.error(
+      "legacy-unsupported",
+      pos,
+      `block '${block}' (${type}): Params is a positional list, but ${type} has no positional form`,
+      {
+        block,
+        expected: `named params: a mapping with ${knownKeys && knownKeys.length ? knownKeys.join(", ") : "no keys"}`,
+      },
+    );
+    return undefined;
   }
+  const positional = args.length === 1 && args[0] === "" ? [] : args;
   try {
-    return {
-      ok: true,
-      params: r.data,
-      converted: legacy ? raw : undefined,
-      outputs: outputNames(def, r.data),
-    };
+    return { raw: def.legacyParams(positional), legacy: true };
   } catch (e) {
-    c.error("bad-params", pos, `block '${block}' (${type}): ${errorMessage(e)}`, { block });
-    return { ...fail, converted: legacy ? raw : undefined };
+    c.error(
+      "legacy-params",
+      pos,
+      `block '${block}' (${type}): cannot convert positional Params [${args.join(", ")}]: ${errorMessage(e)}`,
+      {
+        block,
+        ...(e instanceof LegacyParamsError && e.param ? { param: e.param } : {}),
+        ...(def.legacyForm ? { expected: def.legacyForm } : {}),
+      },
+    );
+    return undefined;
+  }
+}
+
+/** Reports one zod issue at the param it is about (at Params after a conversion). */
+function reportIssue(
+  c: Collector,
+  p: ParamsInput,
+  issue: z.core.$ZodIssue,
+  knownKeys: string[] | undefined,
+  legacy: boolean,
+): void {
+  const { block, node, pos } = p;
+  const type = p.def.type;
+  const path = pathText(issue.path);
+  const at = legacy ? undefined : nodeAtPath(node, issue.path);
+  const where = at ? c.pos(at) : pos;
+  const ex = explainIssue(issue, knownKeys);
+  const subject = path === "" ? "Params" : `param '${path}'`;
+  const unknownKey = issue.code === "unrecognized_keys";
+  let kpos = where;
+  if (unknownKey && isMap(node) && !legacy) {
+    const k = issue.keys[0];
+    const kp = node.items.find((it) => scalarString(it.key) === k);
+    if (kp) kpos = c.pos(kp.key as YamlNode);
+  }
+  const message = unknownKey
+    ? `block '${block}' (${type}): ${ex.message}`
+    : `block '${block}' (${type}): ${subject} ${ex.message}`;
+  c.error(
+    "bad-param",
+    kpos,
+    message + (legacy ? " (after converting the positional Params)" : ""),
+    {
+      block,
+      ...(path !== "" ? { param: path } : {}),
+      ...(ex.expected !== undefined ? { expected: ex.expected } : {}),
+      ...(ex.suggestion !== undefined ? { suggestion: ex.suggestion } : {}),
+    },
+  );
+}
+
+/** The validated params with their output ports (an error when the ports cannot be resolved). */
+function withOutputs(
+  c: Collector,
+  p: ParamsInput,
+  params: unknown,
+  converted: unknown,
+): ParamsResult {
+  const { block, def, pos } = p;
+  try {
+    return { ok: true, params, converted, outputs: outputNames(def, params) };
+  } catch (e) {
+    c.error("bad-params", pos, `block '${block}' (${def.type}): ${errorMessage(e)}`, { block });
+    return failed(converted);
   }
 }
 

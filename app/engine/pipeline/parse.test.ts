@@ -53,4 +53,62 @@ describe("parse stage", () => {
     expect(open.diagnostics[0]!.code).toBe("yaml-syntax");
     expect(open.diagnostics[0]!.line).toBeGreaterThan(0);
   });
+
+  describe("node checks (duplicate keys, aliases)", () => {
+    const limits = { maxDepth: 3, maxParamsValues: 5 };
+    const errors = (src: string) =>
+      parsePipelineYaml(src, limits).doc.errors.map((e) => [e.code, e.pos[0], e.message]);
+    const aliases = (src: string) =>
+      [...parsePipelineYaml(src, limits).aliases].map(([a, n]) => [
+        a.source,
+        a.range?.[0],
+        n.range?.[0],
+      ]);
+
+    test("every duplicate key, in each mapping, missing keys included", () => {
+      const dup = "Map keys must be unique";
+      expect(errors("A: 1\nB: { x: 1, x: 2, ? , ? }\nA: 3\n")).toEqual([
+        ["DUPLICATE_KEY", 16, dup],
+        ["DUPLICATE_KEY", 28, dup],
+        ["DUPLICATE_KEY", 30, dup],
+      ]);
+    });
+
+    test("each alias stands for the latest anchor of its name before it", () => {
+      const src = "a: &x [1, 2]\nb: *x\nc: &x { k: v }\nd: [*x]\ne: &s 1\nf: *s\ng: *nope\n";
+      expect(errors(src)).toEqual([]);
+      expect(aliases(src)).toEqual([
+        ["x", 16, 6],
+        ["x", 38, 25],
+        ["s", 53, 48],
+      ]);
+    });
+
+    test("an alias that stands for too many values, once per alias; then it counts as one", () => {
+      const large = (at: number) => [
+        "ALIAS_TOO_LARGE",
+        at,
+        "alias *y stands for 9 values; an alias may stand for at most 5 (the values one block's Params may hold)",
+      ];
+      expect(errors("a: &x [1, 2, 3]\nb: &y [*x, *x]\nc: [*y, *y]\n")).toEqual([
+        large(35),
+        large(39),
+      ]);
+      expect(errors("a: &x [1, 2, 3]\nb: &y [*x, *x]\nc: &z [*y]\nd: *z\n")).toEqual([large(38)]);
+    });
+
+    test("an alias nested too deep once expanded, and one inside what it stands for", () => {
+      expect(errors("a: &x [[1]]\nb: [[*x]]\n")).toEqual([
+        [
+          "NESTING_TOO_DEEP",
+          17,
+          "nesting too deep: alias *x stands for lists and mappings 2 levels deep, 5 levels here; at most 3",
+        ],
+      ]);
+      expect(errors("a: &x [1, *x]\nb: 2\nb: 3\n")).toEqual([
+        ["ALIAS_CYCLE", 10, "alias *x stands for a list or mapping that contains it"],
+        ["DUPLICATE_KEY", 19, "Map keys must be unique"],
+      ]);
+    });
+  });
 });

@@ -148,6 +148,24 @@ interface Frame {
   height: number;
 }
 
+/** Values below a node (aliases expanded) and its levels of lists and mappings. */
+interface Measure {
+  size: number;
+  height: number;
+}
+
+/** What checkNodes finds and keeps while it walks the nodes. */
+interface NodeCheck {
+  limits: Pick<LoadLimits, "maxDepth" | "maxParamsValues">;
+  errors: YAMLParseError[];
+  aliases: Map<Alias, YamlNode>;
+  /** The latest node that defined each anchor, and what it stands for once closed. */
+  anchors: Map<string, YamlNode>;
+  measured: Map<YamlNode, Measure>;
+  /** Lists and mappings entered and not yet closed (an alias to one of them is a cycle). */
+  open: Set<YamlNode>;
+}
+
 /**
  * One pass over the composed nodes: duplicate keys (as `yaml`'s `uniqueKeys` defines them:
  * scalars with the same value), and aliases that stand for too much (see the file comment).
@@ -156,105 +174,121 @@ function checkNodes(
   doc: Document,
   limits: Pick<LoadLimits, "maxDepth" | "maxParamsValues">,
 ): { errors: YAMLParseError[]; aliases: Map<Alias, YamlNode> } {
-  const errors: YAMLParseError[] = [];
-  const aliases = new Map<Alias, YamlNode>();
+  const s: NodeCheck = {
+    limits,
+    errors: [],
+    aliases: new Map(),
+    anchors: new Map(),
+    measured: new Map(),
+    open: new Set(),
+  };
   const root = doc.contents as YamlNode | null;
-  if (!root) return { errors, aliases };
-  /** The latest node that defined each anchor, and what it stands for once closed. */
-  const anchors = new Map<string, YamlNode>();
-  const measured = new Map<YamlNode, { size: number; height: number }>();
-  const open = new Set<YamlNode>();
-  const childrenOf = (node: YamlNode): (YamlNode | null)[] | undefined => {
-    if (isMap(node)) {
-      const out: (YamlNode | null)[] = [];
-      const seen = new Set<string>();
-      for (const p of node.items) {
-        const k = p.key as YamlNode | null;
-        const id = keyIdentity(k);
-        if (id !== undefined) {
-          if (seen.has(id)) {
-            const at = k?.range?.[0] ?? node.range?.[0] ?? 0;
-            errors.push(
-              new YAMLParseError([at, at + 1], "DUPLICATE_KEY", "Map keys must be unique"),
-            );
-          } else seen.add(id);
-        }
-        out.push(k, p.value as YamlNode | null);
-      }
-      return out;
-    }
-    if (isSeq(node)) return node.items as (YamlNode | null)[];
-    return undefined;
-  };
-  const aliasBudget = limits.maxParamsValues;
-  /** `depth`: lists and mappings around `node`. */
-  const enter = (node: YamlNode, depth: number): Frame | { size: number; height: number } => {
-    if (node.anchor !== undefined && node.anchor !== null) anchors.set(node.anchor, node);
-    if (isAlias(node)) {
-      const target = anchors.get(node.source);
-      const at = node.range?.[0] ?? 0;
-      if (!target) return { size: 1, height: 0 }; // `yaml` reports the unknown anchor
-      aliases.set(node, target);
-      if (open.has(target)) {
-        errors.push(
-          new YAMLParseError(
-            [at, at + 1],
-            ALIAS_CYCLE as ErrorCode,
-            `alias *${node.source} stands for a list or mapping that contains it`,
-          ),
-        );
-        return { size: 1, height: 0 };
-      }
-      const m = measured.get(target) ?? { size: 1, height: 0 };
-      if (m.size > aliasBudget || depth + m.height > limits.maxDepth) {
-        errors.push(
-          new YAMLParseError(
-            [at, at + 1],
-            (m.size > aliasBudget ? ALIAS_TOO_LARGE : TOO_DEEP) as ErrorCode,
-            m.size > aliasBudget
-              ? `alias *${node.source} stands for ${m.size >= 1e15 ? "too many" : m.size} values; an alias may stand for at most ${aliasBudget} (the values one block's Params may hold)`
-              : `nesting too deep: alias *${node.source} stands for lists and mappings ${m.height} levels deep, ${depth + m.height} levels here; at most ${limits.maxDepth}`,
-          ),
-        );
-        // Counted as one value from here on: one report per alias that is too large.
-        return { size: 1, height: 0 };
-      }
-      return m;
-    }
-    const children = childrenOf(node);
-    if (!children) {
-      if (node.anchor) measured.set(node, { size: 1, height: 0 });
-      return { size: 1, height: 0 };
-    }
-    open.add(node);
-    return { node, children, i: 0, size: 1, height: 1 };
-  };
-  const first = enter(root, 0);
-  if (!("children" in first)) return { errors, aliases };
+  if (!root) return { errors: s.errors, aliases: s.aliases };
+  const first = enterNode(s, root, 0);
+  if ("children" in first) walkNodes(s, first);
+  return { errors: s.errors, aliases: s.aliases };
+}
+
+/** Walks the nodes below `first` depth first, without recursion, measuring each as it closes. */
+function walkNodes(s: NodeCheck, first: Frame): void {
   const stack: Frame[] = [first];
   while (stack.length > 0) {
     const f = stack[stack.length - 1]!;
     if (f.i < f.children.length) {
       const child = f.children[f.i++];
       if (!child) continue;
-      const r = enter(child, stack.length);
+      const r = enterNode(s, child, stack.length);
       if ("children" in r) stack.push(r);
-      else {
-        f.size = Math.min(1e15, f.size + r.size);
-        f.height = Math.max(f.height, r.height + 1);
-      }
+      else addChild(f, r);
       continue;
     }
     stack.pop();
-    open.delete(f.node);
-    if (f.node.anchor) measured.set(f.node, { size: f.size, height: f.height });
+    s.open.delete(f.node);
+    if (f.node.anchor) s.measured.set(f.node, { size: f.size, height: f.height });
     const parent = stack[stack.length - 1];
-    if (parent) {
-      parent.size = Math.min(1e15, parent.size + f.size);
-      parent.height = Math.max(parent.height, f.height + 1);
-    }
+    if (parent) addChild(parent, f);
   }
-  return { errors, aliases };
+}
+
+/** Counts a closed child into its parent's size and height. */
+function addChild(parent: Frame, child: Measure): void {
+  parent.size = Math.min(1e15, parent.size + child.size);
+  parent.height = Math.max(parent.height, child.height + 1);
+}
+
+/**
+ * Enters `node` (`depth`: lists and mappings around it): a frame to walk for a list or mapping,
+ * else what it measures.
+ */
+function enterNode(s: NodeCheck, node: YamlNode, depth: number): Frame | Measure {
+  if (node.anchor !== undefined && node.anchor !== null) s.anchors.set(node.anchor, node);
+  if (isAlias(node)) return enterAlias(s, node, depth);
+  const children = childrenOf(s, node);
+  if (!children) {
+    if (node.anchor) s.measured.set(node, { size: 1, height: 0 });
+    return { size: 1, height: 0 };
+  }
+  s.open.add(node);
+  return { node, children, i: 0, size: 1, height: 1 };
+}
+
+/** What an alias measures (its anchor's node); one value when it is refused or names no anchor. */
+function enterAlias(s: NodeCheck, node: Alias, depth: number): Measure {
+  const { limits } = s;
+  const aliasBudget = limits.maxParamsValues;
+  const target = s.anchors.get(node.source);
+  const at = node.range?.[0] ?? 0;
+  if (!target) return { size: 1, height: 0 }; // `yaml` reports the unknown anchor
+  s.aliases.set(node, target);
+  if (s.open.has(target)) {
+    s.errors.push(
+      new YAMLParseError(
+        [at, at + 1],
+        ALIAS_CYCLE as ErrorCode,
+        `alias *${node.source} stands for a list or mapping that contains it`,
+      ),
+    );
+    return { size: 1, height: 0 };
+  }
+  const m = s.measured.get(target) ?? { size: 1, height: 0 };
+  if (m.size > aliasBudget || depth + m.height > limits.maxDepth) {
+    s.errors.push(
+      new YAMLParseError(
+        [at, at + 1],
+        (m.size > aliasBudget ? ALIAS_TOO_LARGE : TOO_DEEP) as ErrorCode,
+        m.size > aliasBudget
+          ? `alias *${node.source} stands for ${m.size >= 1e15 ? "too many" : m.size} values; an alias may stand for at most ${aliasBudget} (the values one block's Params may hold)`
+          : `nesting too deep: alias *${node.source} stands for lists and mappings ${m.height} levels deep, ${depth + m.height} levels here; at most ${limits.maxDepth}`,
+      ),
+    );
+    // Counted as one value from here on: one report per alias that is too large.
+    return { size: 1, height: 0 };
+  }
+  return m;
+}
+
+/** The children of a list or mapping (a mapping's keys and values), reporting duplicate keys. */
+function childrenOf(s: NodeCheck, node: YamlNode): (YamlNode | null)[] | undefined {
+  if (isMap(node)) {
+    const out: (YamlNode | null)[] = [];
+    const seen = new Set<string>();
+    for (const p of node.items) {
+      const k = p.key as YamlNode | null;
+      const id = keyIdentity(k);
+      if (id !== undefined) {
+        if (seen.has(id)) {
+          const at = k?.range?.[0] ?? node.range?.[0] ?? 0;
+          s.errors.push(
+            new YAMLParseError([at, at + 1], "DUPLICATE_KEY", "Map keys must be unique"),
+          );
+        } else seen.add(id);
+      }
+      out.push(k, p.value as YamlNode | null);
+    }
+    return out;
+  }
+  if (isSeq(node)) return node.items as (YamlNode | null)[];
+  return undefined;
 }
 
 /** What makes two keys the same for `yaml`'s `uniqueKeys` (undefined: only itself). */
