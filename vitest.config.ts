@@ -4,6 +4,8 @@ export default defineConfig({
   test: {
     include: [
       "app/**/*.test.ts",
+      // React component tests (type-checked with the DOM and JSX by tsconfig.web.json).
+      "app/ui/**/*.test.tsx",
       "native-bridges/**/*.test.ts",
       "tests/**/*.test.ts",
       "tools/**/*.test.ts",

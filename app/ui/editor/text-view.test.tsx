@@ -1,20 +1,8 @@
-import { createElement, type FC } from "react";
+import { createElement } from "react";
 import { renderToStaticMarkup } from "react-dom/server";
 import { describe, expect, it } from "vitest";
-import type { CatalogInfo } from "../../engine/protocol";
 import type { EditIssue } from "./model";
-
-// Imported by a computed name: test files are type-checked by tsconfig.node.json, which has no
-// JSX, so a static import of the .tsx file does not type-check there (vitest itself compiles it).
-const source = "./text-view.tsx";
-const { TextView } = (await import(source)) as {
-  TextView: FC<{
-    text: string;
-    issues: readonly EditIssue[];
-    catalog: CatalogInfo | undefined;
-    onChange(text: string): void;
-  }>;
-};
+import { TextView } from "./text-view";
 
 /** The server markup (no DOM here: the CodeMirror view itself is made in an effect, which does not run). */
 function markup(issues: EditIssue[]): string {

@@ -1,11 +1,12 @@
 import { ReactFlowProvider } from "@xyflow/react";
-import { createElement, type ComponentType, type Context } from "react";
+import { createElement, type ComponentType } from "react";
 import { renderToStaticMarkup } from "react-dom/server";
 import { afterEach, describe, expect, test, vi } from "vitest";
 import type { BlockInfo } from "../../engine/protocol";
 import type { Telemetry } from "../../engine/runtime/runtime";
 import type { EngineClient } from "../client/engine-client";
 import { EngineContext } from "../client/hooks";
+import { BlockNode as RealBlockNode, GraphStateContext, type GraphState } from "./block-node";
 
 /** The props of every DOM element rendered with an onClick (the menu button), in order. */
 const { clicks, capture } = vi.hoisted(() => {
@@ -35,20 +36,9 @@ afterEach(() => {
   clicks.length = 0;
 });
 
-/** block-node.tsx's GraphState and node props (the test's tsconfig has no JSX to read it with). */
-interface GraphState {
-  running: boolean;
-  openPanels: ReadonlySet<string>;
-  onMenu(block: string, anchor: { x: number; y: number }): void;
-}
+/** The node's props as the tests give them (React Flow passes many more, which it does not read). */
 type NodeProps = { data: { block: BlockInfo; edit?: { issues: string[] } } };
-
-/** Loaded at run time: the tsconfig that checks tests (node) has no JSX to compile the .tsx. */
-const blockNode = "./block-node.tsx";
-const { BlockNode, GraphStateContext } = (await import(blockNode)) as {
-  BlockNode: ComponentType<NodeProps>;
-  GraphStateContext: Context<GraphState>;
-};
+const BlockNode = RealBlockNode as unknown as ComponentType<NodeProps>;
 
 const block = (over: Partial<BlockInfo> = {}): BlockInfo =>
   ({

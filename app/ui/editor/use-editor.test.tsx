@@ -8,7 +8,7 @@ import { afterEach, beforeEach, describe, expect, it, vi } from "vitest";
 const fake = vi.hoisted(() => {
   const slots: unknown[] = [];
   const state = { index: 0, calls: [] as string[] };
-  const slot = <T>(kind: string, init: () => T): { k: number; fresh: boolean } => {
+  const slot = <T,>(kind: string, init: () => T): { k: number; fresh: boolean } => {
     state.calls.push(kind);
     const k = state.index++;
     const fresh = !(k in slots);
@@ -17,7 +17,7 @@ const fake = vi.hoisted(() => {
   };
   const sameDeps = (a: readonly unknown[], b: readonly unknown[]): boolean =>
     a.length === b.length && a.every((x, i) => Object.is(x, b[i]));
-  const memo = <T>(kind: string, make: () => T, deps: readonly unknown[]): T => {
+  const memo = <T,>(kind: string, make: () => T, deps: readonly unknown[]): T => {
     const { k, fresh } = slot(kind, () => ({ value: make(), deps }));
     const m = slots[k] as { value: T; deps: readonly unknown[] };
     if (!fresh && !sameDeps(m.deps, deps)) slots[k] = { value: make(), deps };
@@ -27,7 +27,7 @@ const fake = vi.hoisted(() => {
     slots,
     state,
     react: {
-      useState: <T>(init: T) => {
+      useState: <T,>(init: T) => {
         // As React's, the setter is the same function on every render.
         const { k } = slot("useState", () => {
           const cell = { value: init, set: (v: T) => void (cell.value = v) };
@@ -36,9 +36,9 @@ const fake = vi.hoisted(() => {
         const cell = slots[k] as { value: T; set: (v: T) => void };
         return [cell.value, cell.set];
       },
-      useRef: <T>(init: T) => slots[slot("useRef", () => ({ current: init })).k],
-      useMemo: <T>(make: () => T, deps: readonly unknown[]) => memo("useMemo", make, deps),
-      useCallback: <T>(f: T, deps: readonly unknown[]) => memo("useCallback", () => f, deps),
+      useRef: <T,>(init: T) => slots[slot("useRef", () => ({ current: init })).k],
+      useMemo: <T,>(make: () => T, deps: readonly unknown[]) => memo("useMemo", make, deps),
+      useCallback: <T,>(f: T, deps: readonly unknown[]) => memo("useCallback", () => f, deps),
     },
   };
 });

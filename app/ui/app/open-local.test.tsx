@@ -1,9 +1,10 @@
-import { createElement, type ComponentType } from "react";
+import { createElement } from "react";
 import { renderToStaticMarkup } from "react-dom/server";
 import { afterEach, describe, expect, test, vi } from "vitest";
 import type { Reply } from "../client/engine-client";
 import type { EngineClient } from "../client/engine-client";
 import { EngineContext } from "../client/hooks";
+import { OpenLocal } from "./open-local";
 
 /** The props of every DOM element rendered with an onChange (the file inputs), in order. */
 const { inputs, capture } = vi.hoisted(() => {
@@ -29,16 +30,6 @@ vi.mock("react/jsx-runtime", async (orig) => {
     jsxs: capture(m.jsxs as (...a: unknown[]) => unknown),
   };
 });
-
-/** Loaded at run time: the tsconfig that checks tests (node) has no JSX to compile the .tsx. */
-const openLocal = "./open-local.tsx";
-const { OpenLocal } = (await import(openLocal)) as {
-  OpenLocal: ComponentType<{
-    inPage: boolean;
-    onOpen(file: string, text: string): Promise<Reply>;
-    notify(message: string, level?: "info" | "error"): void;
-  }>;
-};
 
 afterEach(() => {
   inputs.length = 0;
