@@ -75,13 +75,24 @@ describe("parse stage", () => {
     });
 
     test("each alias stands for the latest anchor of its name before it", () => {
-      const src = "a: &x [1, 2]\nb: *x\nc: &x { k: v }\nd: [*x]\ne: &s 1\nf: *s\ng: *nope\n";
+      const src = "a: &x [1, 2]\nb: *x\nc: &x { k: v }\nd: [*x]\ne: &s 1\nf: *s\n";
       expect(errors(src)).toEqual([]);
       expect(aliases(src)).toEqual([
         ["x", 16, 6],
         ["x", 38, 25],
         ["s", 53, 48],
       ]);
+    });
+
+    test("an alias without an anchor before it is an error at the alias", () => {
+      const none = (name: string, at: number) => [
+        "UNRESOLVED_ALIAS",
+        at,
+        `alias *${name} has no anchor &${name} before it (an anchor must come before its aliases)`,
+      ];
+      expect(errors("a: *nope\n")).toEqual([none("nope", 3)]);
+      // An anchor after the alias does not count (YAML resolves aliases backwards only).
+      expect(errors("a: [1, *x]\nb: &x 2\n")).toEqual([none("x", 7)]);
     });
 
     test("an alias that stands for too many values, once per alias; then it counts as one", () => {

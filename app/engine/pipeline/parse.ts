@@ -51,6 +51,7 @@ const OPTIONS = { uniqueKeys: false, prettyErrors: false } as const;
 const TOO_DEEP = "NESTING_TOO_DEEP";
 const ALIAS_TOO_LARGE = "ALIAS_TOO_LARGE";
 const ALIAS_CYCLE = "ALIAS_CYCLE";
+const UNRESOLVED_ALIAS = "UNRESOLVED_ALIAS";
 
 /** Parses pipeline YAML the way the loader and the editor do (see the file comment). */
 export function parsePipelineYaml(
@@ -238,7 +239,18 @@ function enterAlias(s: NodeCheck, node: Alias, depth: number): Measure {
   const aliasBudget = limits.maxParamsValues;
   const target = s.anchors.get(node.source);
   const at = node.range?.[0] ?? 0;
-  if (!target) return { size: 1, height: 0 }; // `yaml` reports the unknown anchor
+  if (!target) {
+    // `yaml` itself only notices when the value is read (and then the block's Params read as
+    // nothing, or as a message without the alias's place): say it here, where it is.
+    s.errors.push(
+      new YAMLParseError(
+        [at, at + 1],
+        UNRESOLVED_ALIAS as ErrorCode,
+        `alias *${node.source} has no anchor &${node.source} before it (an anchor must come before its aliases)`,
+      ),
+    );
+    return { size: 1, height: 0 };
+  }
   s.aliases.set(node, target);
   if (s.open.has(target)) {
     s.errors.push(
@@ -359,6 +371,8 @@ export function syntaxDiagnostic(
     return { code: "nesting-too-deep", at: p, message: first };
   } else if (code === ALIAS_TOO_LARGE || code === ALIAS_CYCLE) {
     return { code: "alias-too-large", at: p, message: first };
+  } else if (code === UNRESOLVED_ALIAS) {
+    return { code: "unresolved-alias", at: p, message: first };
   } else if (/Maximum call stack size exceeded/.test(first)) {
     // What the composer says when a structure is too deep for the stack (kept as a net: the
     // depth limit refuses such files first).
