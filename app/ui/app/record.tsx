@@ -4,7 +4,7 @@
  * and the file, duration, size and samples written; Stop finishes the file (a download in the
  * browser build, where the engine keeps it in memory).
  */
-import { useEffect, useId, useMemo, useRef, useState } from "react";
+import { useEffect, useId, useMemo, useRef, useState, type RefObject } from "react";
 import type { GraphInfo, RecordingFormatName, RecordingStatus } from "../../engine/protocol";
 import { useEngine, useEngineInfo } from "../client/hooks";
 
@@ -68,6 +68,116 @@ export function recordingSummary(r: RecordingStatus): string {
   return `${name} · ${r.duration.toFixed(1)} s · ${formatSize(r.bytes)} · ${samples} samples`;
 }
 
+/** The outputs to record and the format, as picked in the dialog (acquisition outputs first). */
+function useRecordChoice(graph: GraphInfo | undefined) {
+  const outputs = useMemo(() => recordableOutputs(graph), [graph]);
+  const [chosen, setChosen] = useState<Set<string>>(
+    () => new Set(outputs.filter((o) => o.acquisition).map((o) => o.key)),
+  );
+  const [format, setFormat] = useState<RecordingFormatName>("xdf");
+  return { outputs, chosen, setChosen, format, setFormat };
+}
+
+/** Opens the dialog as a modal once it is mounted. */
+function useShowModal(ref: RefObject<HTMLDialogElement | null>): void {
+  useEffect(() => {
+    const d = ref.current;
+    if (d && !d.open) d.showModal();
+  }, []);
+}
+
+/** A copy of `chosen` with `key` added (`on`) or removed. */
+function toggled(chosen: Set<string>, key: string, on: boolean): Set<string> {
+  const next = new Set(chosen);
+  if (on) next.add(key);
+  else next.delete(key);
+  return next;
+}
+
+/** A checkbox for every recordable output (or why there is none). */
+function OutputChoices({
+  outputs,
+  chosen,
+  onToggle,
+}: {
+  outputs: RecordableOutput[];
+  chosen: Set<string>;
+  onToggle(key: string, on: boolean): void;
+}) {
+  return (
+    <fieldset className="record-dialog__outputs">
+      <legend>Outputs</legend>
+      {outputs.length === 0 ? <p>This pipeline has no output to record.</p> : null}
+      {outputs.map((o) => (
+        <label key={o.key} className="record-dialog__output">
+          <input
+            type="checkbox"
+            checked={chosen.has(o.key)}
+            onChange={(e) => onToggle(o.key, e.target.checked)}
+          />
+          <span className="record-dialog__name">{o.key}</span>
+          <span className="record-dialog__detail">{o.detail}</span>
+        </label>
+      ))}
+    </fieldset>
+  );
+}
+
+/** A radio button for every file format. */
+function FormatChoices({
+  name,
+  format,
+  onFormat,
+}: {
+  name: string;
+  format: RecordingFormatName;
+  onFormat(format: RecordingFormatName): void;
+}) {
+  return (
+    <fieldset className="record-dialog__formats">
+      <legend>Format</legend>
+      {FORMATS.map((f) => (
+        <label key={f.value} title={f.hint}>
+          <input
+            type="radio"
+            name={name}
+            value={f.value}
+            checked={format === f.value}
+            onChange={() => onFormat(f.value)}
+          />
+          {f.label}
+        </label>
+      ))}
+    </fieldset>
+  );
+}
+
+/** Where the file goes: downloaded (engine in the page) or written as it records. */
+function RecordWhere({ inPage }: { inPage: boolean }) {
+  return (
+    <p className="record-dialog__where">
+      {inPage
+        ? "Kept in memory while it records, downloaded when you stop it."
+        : "Written to recordings/ in the data folder (else the pipeline's folder) as it records."}
+    </p>
+  );
+}
+
+/** Cancel, and Start recording (disabled while nothing is picked). */
+function DialogButtons({ canStart, onClose }: { canStart: boolean; onClose(): void }) {
+  return (
+    <div className="record-dialog__buttons">
+      <button type="button" onClick={onClose}>
+        Cancel
+      </button>
+      <button type="submit" className="primary" disabled={!canStart}>
+        Start recording
+      </button>
+    </div>
+  );
+}
+
+/** The Record dialog: pick outputs and a format, then Start recording (or Cancel). */
 function RecordDialog({
   graph,
   onStart,
@@ -80,23 +190,10 @@ function RecordDialog({
   const ref = useRef<HTMLDialogElement>(null);
   // The browser build's engine runs in the page and cannot write files.
   const inPage = useEngineInfo().engine.startsWith("browser");
-  const outputs = useMemo(() => recordableOutputs(graph), [graph]);
-  const [chosen, setChosen] = useState<Set<string>>(
-    () => new Set(outputs.filter((o) => o.acquisition).map((o) => o.key)),
-  );
-  const [format, setFormat] = useState<RecordingFormatName>("xdf");
+  const { outputs, chosen, setChosen, format, setFormat } = useRecordChoice(graph);
   const id = useId();
-  useEffect(() => {
-    const d = ref.current;
-    if (d && !d.open) d.showModal();
-  }, []);
-  const toggle = (key: string, on: boolean): void =>
-    setChosen((s) => {
-      const next = new Set(s);
-      if (on) next.add(key);
-      else next.delete(key);
-      return next;
-    });
+  useShowModal(ref);
+  const toggle = (key: string, on: boolean): void => setChosen((s) => toggled(s, key, on));
   const picked = outputs.filter((o) => chosen.has(o.key));
   return (
     <dialog
@@ -114,49 +211,10 @@ function RecordDialog({
         }}
       >
         <h2 id={`${id}-title`}>Record</h2>
-        <fieldset className="record-dialog__outputs">
-          <legend>Outputs</legend>
-          {outputs.length === 0 ? <p>This pipeline has no output to record.</p> : null}
-          {outputs.map((o) => (
-            <label key={o.key} className="record-dialog__output">
-              <input
-                type="checkbox"
-                checked={chosen.has(o.key)}
-                onChange={(e) => toggle(o.key, e.target.checked)}
-              />
-              <span className="record-dialog__name">{o.key}</span>
-              <span className="record-dialog__detail">{o.detail}</span>
-            </label>
-          ))}
-        </fieldset>
-        <fieldset className="record-dialog__formats">
-          <legend>Format</legend>
-          {FORMATS.map((f) => (
-            <label key={f.value} title={f.hint}>
-              <input
-                type="radio"
-                name={`${id}-format`}
-                value={f.value}
-                checked={format === f.value}
-                onChange={() => setFormat(f.value)}
-              />
-              {f.label}
-            </label>
-          ))}
-        </fieldset>
-        <p className="record-dialog__where">
-          {inPage
-            ? "Kept in memory while it records, downloaded when you stop it."
-            : "Written to recordings/ in the data folder (else the pipeline's folder) as it records."}
-        </p>
-        <div className="record-dialog__buttons">
-          <button type="button" onClick={onClose}>
-            Cancel
-          </button>
-          <button type="submit" className="primary" disabled={picked.length === 0}>
-            Start recording
-          </button>
-        </div>
+        <OutputChoices outputs={outputs} chosen={chosen} onToggle={toggle} />
+        <FormatChoices name={`${id}-format`} format={format} onFormat={setFormat} />
+        <RecordWhere inPage={inPage} />
+        <DialogButtons canStart={picked.length > 0} onClose={onClose} />
       </form>
     </dialog>
   );

@@ -81,9 +81,9 @@ function CommitField({
   );
 }
 
-export function Inspector(props: InspectorProps): ReactNode {
-  const { block: b, type: t, issues } = props;
-  const info: BlockInfo = {
+/** The block as the engine would list it, for the params form (the type's schema and live). */
+function blockInfo(b: EditBlock, t: BlockTypeInfo | undefined): BlockInfo {
+  return {
     name: b.name,
     type: t?.type ?? b.type,
     category: t?.category ?? "",
@@ -101,62 +101,121 @@ export function Inspector(props: InspectorProps): ReactNode {
     paramsSchema: t?.paramsSchema ?? {},
     actions: [],
   };
+}
+
+/** "1–3 input(s), comma-separated; …" from the type's fewest and most inputs. */
+function inputsHint(t: BlockTypeInfo): string {
+  return `${t.inputs.min}${t.inputs.max === null ? "+" : t.inputs.max === t.inputs.min ? "" : `–${t.inputs.max}`} input(s), comma-separated; Block.port for another output, -Block: not subscribed`;
+}
+
+/** The inputs as typed: separated by commas or spaces, empty ones left out. */
+function parseInputs(s: string): string[] {
+  return s
+    .split(/[,\s]+/)
+    .map((x) => x.trim())
+    .filter((x) => x !== "");
+}
+
+/** The block's name and its type's. */
+function InspectorTitle({ name, type }: { name: string; type: string }): ReactNode {
+  return (
+    <h3 className="inspector__title">
+      {name} <span className="inspector__type">{type || "(no type)"}</span>
+    </h3>
+  );
+}
+
+/** The type's summary, with its help when opened (nothing for an unknown type). */
+function TypeHelp({ type: t }: { type: BlockTypeInfo | undefined }): ReactNode {
+  return t ? (
+    <details className="inspector__help">
+      <summary>{t.summary}</summary>
+      <p>{t.help}</p>
+    </details>
+  ) : null;
+}
+
+/** The problems of this block (nothing when it has none). */
+function BlockIssues({
+  block,
+  issues,
+}: {
+  block: string;
+  issues: readonly EditIssue[];
+}): ReactNode {
+  const mine = issues.filter((i) => i.block === block);
+  return mine.length > 0 ? (
+    <ul className="inspector__issues" aria-label="Problems">
+      {mine.map((i, k) => (
+        <li key={k}>{i.message}</li>
+      ))}
+    </ul>
+  ) : null;
+}
+
+/** DesiredRate: empty inherits it, else a positive number of Hz. */
+function RateField({ props }: { props: InspectorProps }): ReactNode {
+  const { block: b, type: t } = props;
+  return (
+    <CommitField
+      label="DesiredRate (Hz)"
+      value={b.desiredRate !== undefined ? String(b.desiredRate) : ""}
+      inputMode="decimal"
+      placeholder={t?.requiresRate ? "required" : "inherited from the inputs"}
+      onCommit={(s) => {
+        if (s === "") return props.onDesiredRate(undefined);
+        const n = Number(s);
+        if (!Number.isFinite(n) || n <= 0) return "a positive number of Hz";
+        return props.onDesiredRate(n);
+      }}
+    />
+  );
+}
+
+/** Inputs, comma-separated ("-Block": not subscribed), with the number the type takes. */
+function InputsField({ props }: { props: InspectorProps }): ReactNode {
+  const { block: b, type: t } = props;
   const inputsText = b.inputs.map((i) => `${i.subscribed ? "" : "-"}${i.source}`).join(", ");
-  const mine = issues.filter((i) => i.block === b.name);
+  return (
+    <CommitField
+      label="Inputs"
+      value={inputsText}
+      placeholder={t && t.inputs.min === 0 && t.inputs.max === 0 ? "none" : "e.g. Timer, Emg"}
+      hint={t ? inputsHint(t) : undefined}
+      onCommit={(s) => props.onInputs(parseInputs(s))}
+    />
+  );
+}
+
+/** The params form generated from the type's schema (a hint for an unknown type). */
+function BlockParams({ props }: { props: InspectorProps }): ReactNode {
+  return props.type ? (
+    <ParamsForm
+      block={blockInfo(props.block, props.type)}
+      engineState="loaded"
+      onSet={(param, value) => props.onParam(param, value)}
+      onEditStatic={(param, value) => props.onParam(param, value)}
+    />
+  ) : (
+    <p className="inspector__hint">Unknown type: no params form.</p>
+  );
+}
+
+export function Inspector(props: InspectorProps): ReactNode {
+  const { block: b, type: t, issues } = props;
   return (
     <section className="inspector" aria-label={`Inspector: ${b.name}`} data-inspector={b.name}>
-      <h3 className="inspector__title">
-        {b.name} <span className="inspector__type">{info.type || "(no type)"}</span>
-      </h3>
-      {t ? (
-        <details className="inspector__help">
-          <summary>{t.summary}</summary>
-          <p>{t.help}</p>
-        </details>
-      ) : null}
-      {mine.length > 0 ? (
-        <ul className="inspector__issues" aria-label="Problems">
-          {mine.map((i, k) => (
-            <li key={k}>{i.message}</li>
-          ))}
-        </ul>
-      ) : null}
+      <InspectorTitle name={b.name} type={t?.type ?? b.type} />
+      <TypeHelp type={t} />
+      <BlockIssues block={b.name} issues={issues} />
       <CommitField
         label="Name"
         value={b.name}
         hint="Enter to rename (inputs that name it follow)"
         onCommit={(s) => props.onRename(s)}
       />
-      <CommitField
-        label="DesiredRate (Hz)"
-        value={b.desiredRate !== undefined ? String(b.desiredRate) : ""}
-        inputMode="decimal"
-        placeholder={t?.requiresRate ? "required" : "inherited from the inputs"}
-        onCommit={(s) => {
-          if (s === "") return props.onDesiredRate(undefined);
-          const n = Number(s);
-          if (!Number.isFinite(n) || n <= 0) return "a positive number of Hz";
-          return props.onDesiredRate(n);
-        }}
-      />
-      <CommitField
-        label="Inputs"
-        value={inputsText}
-        placeholder={t && t.inputs.min === 0 && t.inputs.max === 0 ? "none" : "e.g. Timer, Emg"}
-        hint={
-          t
-            ? `${t.inputs.min}${t.inputs.max === null ? "+" : t.inputs.max === t.inputs.min ? "" : `–${t.inputs.max}`} input(s), comma-separated; Block.port for another output, -Block: not subscribed`
-            : undefined
-        }
-        onCommit={(s) =>
-          props.onInputs(
-            s
-              .split(/[,\s]+/)
-              .map((x) => x.trim())
-              .filter((x) => x !== ""),
-          )
-        }
-      />
+      <RateField props={props} />
+      <InputsField props={props} />
       <CommitField
         label="Path (log)"
         value={b.path ?? ""}
@@ -165,16 +224,7 @@ export function Inspector(props: InspectorProps): ReactNode {
       />
       <h4 className="inspector__params-title">Params</h4>
       <RunningValues block={b} running={props.runningBlock} />
-      {t ? (
-        <ParamsForm
-          block={info}
-          engineState="loaded"
-          onSet={(param, value) => props.onParam(param, value)}
-          onEditStatic={(param, value) => props.onParam(param, value)}
-        />
-      ) : (
-        <p className="inspector__hint">Unknown type: no params form.</p>
-      )}
+      <BlockParams props={props} />
     </section>
   );
 }

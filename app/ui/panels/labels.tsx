@@ -39,6 +39,7 @@ export function LabelDisplay({ block, active }: { block: BlockInfo; active: bool
   );
 }
 
+/** What an output sent last: its latest event's values and how many events it sent. */
 interface Latest {
   t: number;
   rows: number;
@@ -47,15 +48,11 @@ interface Latest {
   events: number;
 }
 
-function OutputValues({
-  block,
-  output,
-  active,
-}: {
-  block: BlockInfo;
-  output: OutputInfo;
-  active: boolean;
-}): ReactNode {
+/**
+ * Watches the output while `active` and keeps its latest event; re-renders at most every
+ * REFRESH_MS, on an animation frame, when something new came.
+ */
+function useLatestEvent(block: BlockInfo, output: OutputInfo, active: boolean): Latest {
   const { rows, cols } = output.shape;
   const stride = rows * cols;
   const latest = useRef<Latest>({ t: NaN, rows, cols, v: new Float64Array(stride), events: 0 });
@@ -84,36 +81,79 @@ function OutputValues({
       setTick((x) => x + 1);
     });
   }, [active]);
+  return latest.current;
+}
 
-  const l = latest.current;
-  const has = Number.isFinite(l.t);
-  const shown = Math.min(stride, LABELS_MAX);
-  let summary: ReactNode = null;
-  if (has && stride > LABELS_MAX) {
-    let lo = Infinity;
-    let hi = -Infinity;
-    let sum = 0;
-    for (let i = 0; i < stride; i++) {
-      const x = l.v[i]!;
-      if (x < lo) lo = x;
-      if (x > hi) hi = x;
-      sum += x;
-    }
-    summary = (
-      <p className="mp-muted">
-        all {stride}: min {formatValue(lo)}, mean {formatValue(sum / stride)}, max {formatValue(hi)}{" "}
-        — the first {LABELS_MAX} below
-      </p>
-    );
+/** The smallest, largest and sum of the first `stride` values. */
+function valueRange(v: Float64Array, stride: number): { lo: number; hi: number; sum: number } {
+  let lo = Infinity;
+  let hi = -Infinity;
+  let sum = 0;
+  for (let i = 0; i < stride; i++) {
+    const x = v[i]!;
+    if (x < lo) lo = x;
+    if (x > hi) hi = x;
+    sum += x;
   }
+  return { lo, hi, sum };
+}
+
+/** Min, mean and max of all the values when there are more than are listed (else nothing). */
+function ValuesSummary({ latest, stride }: { latest: Latest; stride: number }): ReactNode {
+  if (stride <= LABELS_MAX) return null;
+  const { lo, hi, sum } = valueRange(latest.v, stride);
+  return (
+    <p className="mp-muted">
+      all {stride}: min {formatValue(lo)}, mean {formatValue(sum / stride)}, max {formatValue(hi)} —
+      the first {LABELS_MAX} below
+    </p>
+  );
+}
+
+/** The first LABELS_MAX values, each by its channel label (or [row, col] for a matrix). */
+function ValueList({ latest, output }: { latest: Latest; output: OutputInfo }): ReactNode {
+  const { rows, cols } = output.shape;
+  const shown = Math.min(rows * cols, LABELS_MAX);
+  return (
+    <dl className="mp-values">
+      {Array.from({ length: shown }, (_x, i) => (
+        <div key={i} className="mp-value">
+          <dt>{rows > 1 ? `[${Math.floor(i / cols)}, ${i % cols}]` : channelLabel(output, i)}</dt>
+          <dd>{formatValue(latest.v[i]!)}</dd>
+        </div>
+      ))}
+    </dl>
+  );
+}
+
+/** The output's name and shape. */
+function OutputHeading({ output }: { output: OutputInfo }): ReactNode {
+  return (
+    <h4 className="mp-output-name">
+      {output.name}{" "}
+      <span className="mp-muted">
+        [{output.shape.rows}, {output.shape.cols}]
+      </span>
+    </h4>
+  );
+}
+
+/** One output: its heading and its latest values (or why there are none). */
+function OutputValues({
+  block,
+  output,
+  active,
+}: {
+  block: BlockInfo;
+  output: OutputInfo;
+  active: boolean;
+}): ReactNode {
+  const l = useLatestEvent(block, output, active);
+  const stride = output.shape.rows * output.shape.cols;
+  const has = Number.isFinite(l.t);
   return (
     <section className="mp-output" aria-label={`Output ${output.name}`}>
-      <h4 className="mp-output-name">
-        {output.name}{" "}
-        <span className="mp-muted">
-          [{rows}, {cols}]
-        </span>
-      </h4>
+      <OutputHeading output={output} />
       {stride === 0 ? (
         <p className="mp-muted">
           events without values (a timer): {has ? `${l.events} ticks seen` : "no tick seen yet"}
@@ -122,17 +162,8 @@ function OutputValues({
         <p className="mp-muted">{active ? "waiting for data…" : "hidden: no data is watched"}</p>
       ) : (
         <>
-          {summary}
-          <dl className="mp-values">
-            {Array.from({ length: shown }, (_x, i) => (
-              <div key={i} className="mp-value">
-                <dt>
-                  {rows > 1 ? `[${Math.floor(i / cols)}, ${i % cols}]` : channelLabel(output, i)}
-                </dt>
-                <dd>{formatValue(l.v[i]!)}</dd>
-              </div>
-            ))}
-          </dl>
+          <ValuesSummary latest={l} stride={stride} />
+          <ValueList latest={l} output={output} />
         </>
       )}
     </section>
