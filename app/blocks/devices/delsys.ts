@@ -4,6 +4,7 @@ import {
   defineBlock,
   vectorShape,
   type BlockContext,
+  type OutputPort,
   type PortMeta,
 } from "../../engine";
 import { plural, TextThrottle } from "../shared/text";
@@ -246,19 +247,57 @@ function nativeSource(
   target: string,
   onLink: (l: TrignoLink) => void,
 ) {
-  if (ctx.declaredRate === undefined) ctx.setDesiredRate(TRIGNO_NATIVE_RATE);
-  const k = trignoWidth(o);
-  const out = ctx.output(vectorShape(k), "emg", outputMeta(o));
-  const clock = new DeviceClock(TRIGNO_NATIVE_RATE);
-  const throttle = new TextThrottle(0.5);
-  let link: TrignoLink | undefined;
-  let phase = "stopped";
-  let lastText = "";
-  let shownGaps = 0;
+  return new DelsysNativeRun(ctx, o, target, onLink).instance();
+}
 
-  const refresh = (): void => {
-    let text = phase;
-    const c = link?.counts;
+/** The state of the native form: the link, the device's sample clock and the status. */
+class DelsysNativeRun {
+  private readonly k: number;
+  private readonly out: OutputPort;
+  private readonly clock: DeviceClock;
+  private readonly throttle = new TextThrottle(0.5);
+  private link: TrignoLink | undefined;
+  private phase = "stopped";
+  private lastText = "";
+  private shownGaps = 0;
+
+  constructor(
+    private readonly ctx: BlockContext,
+    private readonly o: TrignoLinkOptions,
+    private readonly target: string,
+    private readonly onLink: (l: TrignoLink) => void,
+  ) {
+    if (ctx.declaredRate === undefined) ctx.setDesiredRate(TRIGNO_NATIVE_RATE);
+    this.k = trignoWidth(o);
+    this.out = ctx.output(vectorShape(this.k), "emg", outputMeta(o));
+    this.clock = new DeviceClock(TRIGNO_NATIVE_RATE);
+    this.refresh();
+  }
+
+  /** The block instance the engine drives. */
+  instance() {
+    return {
+      start: () => this.start(),
+      stop: () => this.stop(),
+      reset: () => this.reset(),
+      dispose: () => this.dispose(),
+    };
+  }
+
+  /** The status: the link's phase and its counts, when it changed. */
+  private refresh(): void {
+    const text = this.statusText();
+    if (text !== this.lastText) {
+      this.lastText = text;
+      this.ctx.setText(text);
+    }
+  }
+
+  /** The link's phase, then each count that is not zero. */
+  private statusText(): string {
+    let text = this.phase;
+    const c = this.link?.counts;
+    const clock = this.clock;
     if (c) {
       if (c.samples > 0) text += ` · ${plural(c.samples, "sample")}`;
       if (c.reconnections > 0) text += ` · ${plural(c.reconnections, "reconnection")}`;
@@ -269,65 +308,69 @@ function nativeSource(
       if (c.aux.held > 0) text += ` · ${c.aux.held} samples with held AUX`;
       if (clock.reanchors > 0) text += ` · re-anchored ${clock.reanchors}×`;
     }
-    if (text !== lastText) {
-      lastText = text;
-      ctx.setText(text);
-    }
-  };
+    return text;
+  }
 
-  const onSamples = (values: Float64Array, n: number): void => {
-    const f = out.frame(n);
-    clock.stamp(ctx.now(), f.t, n);
-    f.v.set(values.subarray(0, n * k));
-    out.emit(f);
+  /** The samples of one batch from the link go out as one frame on the device's clock. */
+  private onSamples(values: Float64Array, n: number): void {
+    const f = this.out.frame(n);
+    this.clock.stamp(this.ctx.now(), f.t, n);
+    f.v.set(values.subarray(0, n * this.k));
+    this.out.emit(f);
     // A gap (after a reconnection) shows at once; the counts every half second.
-    if (clock.gaps !== shownGaps) {
-      shownGaps = clock.gaps;
-      refresh();
-    } else if (throttle.due(ctx.now())) refresh();
-  };
+    if (this.clock.gaps !== this.shownGaps) {
+      this.shownGaps = this.clock.gaps;
+      this.refresh();
+    } else if (this.throttle.due(this.ctx.now())) this.refresh();
+  }
 
-  refresh();
-  return {
-    start() {
-      const tcp = ctx.io.tcp;
-      if (!tcp) {
-        phase = "TCP not available in the browser build; use --simulate-devices";
-        refresh();
-        ctx.warn(noTcpMessage(target));
-        return;
-      }
-      link = new TrignoLink(ctx, tcp, o, {
-        samples: onSamples,
-        state(_phase, text) {
-          phase = text;
-          refresh();
-        },
-        warn: (m) => ctx.warn(`Delsys Trigno: ${m}`),
-        started(rate) {
-          clock.setRate(rate);
-        },
-        broke() {
-          clock.restart();
-        },
-      });
-      onLink(link);
-      link.open();
-    },
-    stop() {
-      link?.close();
-      phase = "stopped";
-      refresh();
-    },
-    reset() {
-      clock.reset();
-      shownGaps = 0;
-      throttle.reset();
-      refresh();
-    },
-    dispose() {
-      link?.close();
-      link = undefined;
-    },
-  };
+  /** Opens the link to the TCU, or says that this host has no TCP. */
+  private start(): void {
+    const ctx = this.ctx;
+    const tcp = ctx.io.tcp;
+    if (!tcp) {
+      this.phase = "TCP not available in the browser build; use --simulate-devices";
+      this.refresh();
+      ctx.warn(noTcpMessage(this.target));
+      return;
+    }
+    const clock = this.clock;
+    this.link = new TrignoLink(ctx, tcp, this.o, {
+      samples: (values, n) => this.onSamples(values, n),
+      state: (_phase, text) => {
+        this.phase = text;
+        this.refresh();
+      },
+      warn: (m) => ctx.warn(`Delsys Trigno: ${m}`),
+      started(rate) {
+        clock.setRate(rate);
+      },
+      broke() {
+        clock.restart();
+      },
+    });
+    this.onLink(this.link);
+    this.link.open();
+  }
+
+  /** Closes the link (it sends STOP) and says so. */
+  private stop(): void {
+    this.link?.close();
+    this.phase = "stopped";
+    this.refresh();
+  }
+
+  /** Forgets the clock and the gaps shown. */
+  private reset(): void {
+    this.clock.reset();
+    this.shownGaps = 0;
+    this.throttle.reset();
+    this.refresh();
+  }
+
+  /** Closes the link and lets it go. */
+  private dispose(): void {
+    this.link?.close();
+    this.link = undefined;
+  }
 }

@@ -18,6 +18,7 @@ import {
   vectorShape,
   type BlockContext,
   type BlockInstance,
+  type OutputPort,
   type PortMeta,
   type TcpBridge,
 } from "../../engine";
@@ -316,85 +317,128 @@ export function nativeStreamSource<Raw = Int16Array>(
   ctx: BlockContext,
   o: NativeStreamOptions<Raw>,
 ): BlockInstance {
-  if (ctx.declaredRate === undefined) ctx.setDesiredRate(o.rate);
-  const k = o.channels;
-  const out = ctx.output(vectorShape(k), "emg", o.meta);
-  const clock = new DeviceClock(o.rate, 0.5, o.maxLead);
-  const throttle = new TextThrottle(0.5);
-  let batch = new Float64Array(64 * k);
-  let n = 0;
-  let emitted = 0;
-  let phase = "stopped";
-  let lastText = "";
-  let link: { close(): void } | undefined;
+  return new NativeStreamRun(ctx, o).instance();
+}
 
-  const refresh = (): void => {
-    let text = phase;
-    if (emitted > 0) text += ` · ${plural(emitted, "sample")}`;
-    if (clock.gapSamples > 0) text += ` · ${clock.gapSamples} samples lost in gaps`;
-    if (text !== lastText) {
-      lastText = text;
-      ctx.setText(text);
+/** The state of one native source: the batch of the current chunk, the clock and the status. */
+class NativeStreamRun<Raw> {
+  private readonly k: number;
+  private readonly out: OutputPort;
+  private readonly clock: DeviceClock;
+  private readonly throttle = new TextThrottle(0.5);
+  private batch: Float64Array;
+  private n = 0;
+  private emitted = 0;
+  private phase = "stopped";
+  private lastText = "";
+  private link: { close(): void } | undefined;
+  /** What the link calls, made once. */
+  private readonly events: LinkEvents<Raw>;
+
+  constructor(
+    private readonly ctx: BlockContext,
+    private readonly o: NativeStreamOptions<Raw>,
+  ) {
+    if (ctx.declaredRate === undefined) ctx.setDesiredRate(o.rate);
+    this.k = o.channels;
+    this.out = ctx.output(vectorShape(this.k), "emg", o.meta);
+    this.clock = new DeviceClock(o.rate, 0.5, o.maxLead);
+    this.batch = new Float64Array(64 * this.k);
+    this.events = {
+      samples: (raw) => this.add(raw),
+      chunkEnd: () => this.emitChunk(),
+      state: (p, text) => this.linkState(p, text),
+      warn: (m) => ctx.warn(m),
+    };
+    this.refresh();
+  }
+
+  /** The block instance the engine drives. */
+  instance(): BlockInstance {
+    return {
+      start: () => this.start(),
+      stop: () => this.stop(),
+      reset: () => this.reset(),
+      dispose: () => this.dispose(),
+    };
+  }
+
+  /** The status: the link's phase, the samples emitted and those lost in gaps, when it changed. */
+  private refresh(): void {
+    let text = this.phase;
+    if (this.emitted > 0) text += ` · ${plural(this.emitted, "sample")}`;
+    if (this.clock.gapSamples > 0) text += ` · ${this.clock.gapSamples} samples lost in gaps`;
+    if (text !== this.lastText) {
+      this.lastText = text;
+      this.ctx.setText(text);
     }
-  };
+  }
 
-  const events: LinkEvents<Raw> = {
-    samples(raw) {
-      if ((n + 1) * k > batch.length) {
-        const bigger = new Float64Array(batch.length * 2);
-        bigger.set(batch);
-        batch = bigger;
-      }
-      o.convert(raw, batch, n * k);
-      n++;
-    },
-    chunkEnd() {
-      if (n === 0) return;
-      const f = out.frame(n);
-      clock.stamp(ctx.now(), f.t, n);
-      f.v.set(batch.subarray(0, n * k));
-      out.emit(f);
-      emitted += n;
-      n = 0;
-      if (throttle.due(ctx.now())) refresh();
-    },
-    state(p, text) {
-      if (p !== "streaming") {
-        clock.restart();
-        n = 0;
-      }
-      phase = text;
-      refresh();
-    },
-    warn: (m) => ctx.warn(m),
-  };
+  /** One sample of the chunk, converted into the batch (doubled when full). */
+  private add(raw: Raw): void {
+    const k = this.k;
+    if ((this.n + 1) * k > this.batch.length) {
+      const bigger = new Float64Array(this.batch.length * 2);
+      bigger.set(this.batch);
+      this.batch = bigger;
+    }
+    this.o.convert(raw, this.batch, this.n * k);
+    this.n++;
+  }
 
-  refresh();
-  return {
-    start() {
-      if (!o.available(ctx)) {
-        phase = "TCP not available in the browser build; use --simulate-devices";
-        refresh();
-        ctx.warn(noTcpMessage(o.target));
-        return;
-      }
-      link = o.open(ctx, events);
-    },
-    stop() {
-      link?.close();
-      link = undefined;
-      phase = "stopped";
-      refresh();
-    },
-    reset() {
-      clock.reset();
-      emitted = 0;
-      throttle.reset();
-      refresh();
-    },
-    dispose() {
-      link?.close();
-      link = undefined;
-    },
-  };
+  /** The chunk ended: its samples go out as one frame on the device's clock. */
+  private emitChunk(): void {
+    const n = this.n;
+    if (n === 0) return;
+    const f = this.out.frame(n);
+    this.clock.stamp(this.ctx.now(), f.t, n);
+    f.v.set(this.batch.subarray(0, n * this.k));
+    this.out.emit(f);
+    this.emitted += n;
+    this.n = 0;
+    if (this.throttle.due(this.ctx.now())) this.refresh();
+  }
+
+  /** The link's phase changed: out of streaming, the clock restarts and the batch is dropped. */
+  private linkState(p: LinkPhase, text: string): void {
+    if (p !== "streaming") {
+      this.clock.restart();
+      this.n = 0;
+    }
+    this.phase = text;
+    this.refresh();
+  }
+
+  /** Opens the link, or says that this host has no TCP. */
+  private start(): void {
+    if (!this.o.available(this.ctx)) {
+      this.phase = "TCP not available in the browser build; use --simulate-devices";
+      this.refresh();
+      this.ctx.warn(noTcpMessage(this.o.target));
+      return;
+    }
+    this.link = this.o.open(this.ctx, this.events);
+  }
+
+  /** Closes the link and says so. */
+  private stop(): void {
+    this.link?.close();
+    this.link = undefined;
+    this.phase = "stopped";
+    this.refresh();
+  }
+
+  /** Forgets the clock and the count of samples emitted. */
+  private reset(): void {
+    this.clock.reset();
+    this.emitted = 0;
+    this.throttle.reset();
+    this.refresh();
+  }
+
+  /** Closes the link. */
+  private dispose(): void {
+    this.link?.close();
+    this.link = undefined;
+  }
 }

@@ -1,5 +1,12 @@
 import { z } from "zod";
-import { BlockConfigError, defineBlock, errorMessage, LegacyParamsError } from "../../engine";
+import {
+  BlockConfigError,
+  defineBlock,
+  errorMessage,
+  LegacyParamsError,
+  type BlockContext,
+  type BlockInstance,
+} from "../../engine";
 import type { BufferRows } from "../flow/buffer";
 import { createPythonModule } from "../io/python-backed";
 import { inputName, vectorInput } from "../shared/inputs";
@@ -95,91 +102,140 @@ export const PythonNetLearning = defineBlock({
   async create(ctx, p) {
     const input = vectorInput(ctx, 0);
     const d = input.size;
-    const T = p.Targets;
-    const k = p.Method === "lda-predict" ? T : p.Components;
-    if (p.Method !== "lda-predict" && p.Components > d) {
-      throw new BlockConfigError(
-        `Components ${p.Components} is more than the ${d} values of input ${inputName(input.info)}`,
-        "Components",
-      );
-    }
+    checkComponents(p, d, inputName(input.info));
     const file = p.TrainingFile ?? `${ctx.name}.training.csv`;
-    const inner = await createPythonModule(ctx, {
-      module: "mosaic_blocks.learning",
-      init: "init",
-      function: "apply",
-      params: {
-        method: p.Method,
-        n_components: p.Components,
-        targets: T,
-        features: d,
-        training: ctx.resources.resolve(file),
-        seed: p.Seed,
-      },
-      outputShape: [1, k],
-    });
-    let disposed = false;
-    const train = (): string => {
-      const b = lookup<BufferRows>(ctx, p.Buffer, "Buffer");
-      if (typeof b === "string") throw new Error(`cannot read the Buffer: ${b}`);
-      if (b.dataWidth !== d || b.targetWidth !== T) {
-        throw new Error(
-          `the Buffer '${p.Buffer}' stores targets of ${b.targetWidth} and data of ${b.dataWidth} ` +
-            `values; this block reads ${d} values and Targets is ${T}`,
-        );
-      }
-      const n = b.rows();
-      if (n === 0) return `the Buffer '${p.Buffer}' is empty: nothing to train on`;
-      const v = b.values();
-      const W = T + d;
-      const lines: string[] = [];
-      for (let r = 0; r < n; r++) {
-        const row: string[] = [];
-        for (let c = 0; c < W; c++) row.push(String(v[r * W + c]));
-        lines.push(row.join(","));
-      }
-      ctx.resources.writeText(file, lines.join("\n") + "\n").then(
-        () => {
-          if (!disposed) inner.reset?.();
-        },
-        (e: unknown) => ctx.warn(`cannot write ${file}: ${errorMessage(e)}`),
-      );
-      return `training ${p.Method} on ${plural(n, "row")} of '${p.Buffer}'`;
-    };
-    let unlisten: (() => void) | undefined;
+    const inner = await openSidecar(ctx, p, d, file);
+    return new LearningRun(ctx, p, d, file, inner).instance();
+  },
+});
+
+type Params = z.output<typeof params>;
+
+/** pca, ica and lda-transform cannot give more components than the input has values. */
+function checkComponents(p: Params, d: number, input: string): void {
+  if (p.Method !== "lda-predict" && p.Components > d) {
+    throw new BlockConfigError(
+      `Components ${p.Components} is more than the ${d} values of input ${input}`,
+      "Components",
+    );
+  }
+}
+
+/** Loads mosaic_blocks.learning in the sidecar, on the training file; k outputs. */
+function openSidecar(
+  ctx: BlockContext,
+  p: Params,
+  d: number,
+  file: string,
+): Promise<BlockInstance> {
+  const T = p.Targets;
+  const k = p.Method === "lda-predict" ? T : p.Components;
+  return createPythonModule(ctx, {
+    module: "mosaic_blocks.learning",
+    init: "init",
+    function: "apply",
+    params: {
+      method: p.Method,
+      n_components: p.Components,
+      targets: T,
+      features: d,
+      training: ctx.resources.resolve(file),
+      seed: p.Seed,
+    },
+    outputShape: [1, k],
+  });
+}
+
+/** The Buffer's n rows of W values, as CSV lines (one row a line, a newline at the end). */
+function trainingCsv(v: Float64Array, n: number, W: number): string {
+  const lines: string[] = [];
+  for (let r = 0; r < n; r++) {
+    const row: string[] = [];
+    for (let c = 0; c < W; c++) row.push(String(v[r * W + c]));
+    lines.push(row.join(","));
+  }
+  return lines.join("\n") + "\n";
+}
+
+/** The sidecar's instance with training: the train action, AutoTrain's listener, disposal. */
+class LearningRun {
+  private disposed = false;
+  private unlisten: (() => void) | undefined;
+
+  constructor(
+    private readonly ctx: BlockContext,
+    private readonly p: Params,
+    private readonly d: number,
+    private readonly file: string,
+    private readonly inner: BlockInstance,
+  ) {}
+
+  /** The sidecar's instance, its start and dispose wrapped, a train action added. */
+  instance(): BlockInstance {
+    const inner = this.inner;
     return {
       ...inner,
-      start() {
-        inner.start?.();
-        if (!p.AutoTrain || unlisten) return;
-        const b = lookup<BufferRows>(ctx, p.Buffer, "Buffer");
-        if (typeof b === "string") {
-          ctx.warn(`Buffer '${p.Buffer}': ${b}; the model cannot be trained from it`);
-          return;
-        }
-        unlisten = b.onClusterClosed(() =>
-          ctx.at(ctx.now(), () => {
-            try {
-              train();
-            } catch (e) {
-              ctx.warn(errorMessage(e));
-            }
-          }),
-        );
-      },
-      dispose() {
-        disposed = true;
-        unlisten?.();
-        inner.dispose?.();
-      },
+      start: () => this.start(),
+      dispose: () => this.dispose(),
       actions: {
         ...inner.actions,
         train: {
           label: "Train",
-          description: `Fit the model on the rows of the Buffer '${p.Buffer}'`,
-          run: train,
+          description: `Fit the model on the rows of the Buffer '${this.p.Buffer}'`,
+          run: () => this.train(),
         },
       },
     };
-  },
-});
+  }
+
+  /** Writes the Buffer's rows for the sidecar, which is re-initialised on them once written. */
+  private train(): string {
+    const { ctx, p, d, file } = this;
+    const T = p.Targets;
+    const b = lookup<BufferRows>(ctx, p.Buffer, "Buffer");
+    if (typeof b === "string") throw new Error(`cannot read the Buffer: ${b}`);
+    if (b.dataWidth !== d || b.targetWidth !== T) {
+      throw new Error(
+        `the Buffer '${p.Buffer}' stores targets of ${b.targetWidth} and data of ${b.dataWidth} ` +
+          `values; this block reads ${d} values and Targets is ${T}`,
+      );
+    }
+    const n = b.rows();
+    if (n === 0) return `the Buffer '${p.Buffer}' is empty: nothing to train on`;
+    ctx.resources.writeText(file, trainingCsv(b.values(), n, T + d)).then(
+      () => {
+        if (!this.disposed) this.inner.reset?.();
+      },
+      (e: unknown) => ctx.warn(`cannot write ${file}: ${errorMessage(e)}`),
+    );
+    return `training ${p.Method} on ${plural(n, "row")} of '${p.Buffer}'`;
+  }
+
+  /** Starts the sidecar; with AutoTrain, listens (once) to the Buffer's closed clusters. */
+  private start(): void {
+    const { ctx, p } = this;
+    this.inner.start?.();
+    if (!p.AutoTrain || this.unlisten) return;
+    const b = lookup<BufferRows>(ctx, p.Buffer, "Buffer");
+    if (typeof b === "string") {
+      ctx.warn(`Buffer '${p.Buffer}': ${b}; the model cannot be trained from it`);
+      return;
+    }
+    this.unlisten = b.onClusterClosed(() =>
+      ctx.at(ctx.now(), () => {
+        try {
+          this.train();
+        } catch (e) {
+          ctx.warn(errorMessage(e));
+        }
+      }),
+    );
+  }
+
+  /** Stops listening to the Buffer and disposes of the sidecar. */
+  private dispose(): void {
+    this.disposed = true;
+    this.unlisten?.();
+    this.inner.dispose?.();
+  }
+}
