@@ -12,10 +12,11 @@ import {
   type BlockContext,
   type BlockInstance,
   type Frame,
+  type OutputPort,
 } from "../../engine";
 import { FeatureKernel, WindowedFeatureKernel, type FeatureRequest } from "../../engine/dsp";
 import { requireDsp } from "../shared/dsp";
-import { inputName, signalInput } from "../shared/inputs";
+import { inputName, signalInput, type SignalInput } from "../shared/inputs";
 
 /** Most samples per window / between windows (a bound that keeps the ring allocatable). */
 export const MAX_WINDOW = 1 << 20;
@@ -87,44 +88,31 @@ export function createFeatureBlock<P extends WindowingParams>(
   const out = ctx.output(vectorShape(width));
 
   if (rows >= 2) {
-    if (params.Window !== undefined || params.Hop !== undefined) {
-      throw new BlockConfigError(
-        `input ${inputName(sig.info)} already carries windows ${formatShape(sig.shape)}; Window ` +
-          "and Hop are only for a plain stream [1, C], remove them",
-        params.Window !== undefined ? "Window" : "Hop",
-      );
-    }
-    const build = (q: P): FeatureKernel => {
-      try {
-        return new FeatureKernel(requests(q), rows, cols);
-      } catch (e) {
-        throw new BlockConfigError(`cannot create the feature kernel: ${errorMessage(e)}`);
-      }
-    };
-    let kernel = build(current);
-    return {
-      process(f: Frame) {
-        const n = f.n;
-        if (n === 0) return;
-        const o = out.frame(n);
-        const ft = f.t;
-        for (let e = 0; e < n; e++) o.t[e] = ft[e]!;
-        kernel.process(f.v, o.v, n);
-        out.emit(o);
-      },
-      setParam(name, value) {
-        const next = { ...current, [name]: value };
-        const k = build(next);
-        kernel.dispose();
-        kernel = k;
-        Object.assign(current, next);
-      },
-      dispose() {
-        kernel.dispose();
-      },
-    };
+    checkNoWindowing(sig, params);
+    return new WindowMatrixRun(rows, cols, current, requests, out).instance();
   }
 
+  const length = streamWindow(ctx, sig, params);
+  const hop = params.Hop ?? length;
+  checkWindowValues(length, cols);
+  if (ctx.declaredRate === undefined && sig.info.rate > 0) ctx.setDesiredRate(sig.info.rate / hop);
+  const kernel = windowedKernel(reqs, length, hop, cols);
+  return new StreamRun(kernel, current, requests, out).instance();
+}
+
+/** Window matrices come windowed already: Window and Hop must be left out. */
+function checkNoWindowing(sig: SignalInput, params: WindowingParams): void {
+  if (params.Window !== undefined || params.Hop !== undefined) {
+    throw new BlockConfigError(
+      `input ${inputName(sig.info)} already carries windows ${formatShape(sig.shape)}; Window ` +
+        "and Hop are only for a plain stream [1, C], remove them",
+      params.Window !== undefined ? "Window" : "Hop",
+    );
+  }
+}
+
+/** The window length of a plain stream: Window, which such an input needs. */
+function streamWindow(ctx: BlockContext, sig: SignalInput, params: WindowingParams): number {
   if (params.Window === undefined) {
     throw new BlockConfigError(
       `input ${inputName(sig.info)} is a plain stream ${formatShape(sig.shape)}: set Window (and ` +
@@ -132,8 +120,11 @@ export function createFeatureBlock<P extends WindowingParams>(
       "Window",
     );
   }
-  const length = params.Window;
-  const hop = params.Hop ?? length;
+  return params.Window;
+}
+
+/** A window of `length` samples × `cols` channels must hold at most MAX_WINDOW_VALUES values. */
+function checkWindowValues(length: number, cols: number): void {
   if (length * cols > MAX_WINDOW_VALUES) {
     throw new BlockConfigError(
       `a window of ${length} samples × ${cols} channels holds more than ${MAX_WINDOW_VALUES} ` +
@@ -141,34 +132,111 @@ export function createFeatureBlock<P extends WindowingParams>(
       "Window",
     );
   }
-  if (ctx.declaredRate === undefined && sig.info.rate > 0) ctx.setDesiredRate(sig.info.rate / hop);
-  let kernel: WindowedFeatureKernel;
+}
+
+/** The kernel that windows a plain stream itself, its failure reported on Window. */
+function windowedKernel(
+  reqs: FeatureRequest[],
+  length: number,
+  hop: number,
+  cols: number,
+): WindowedFeatureKernel {
   try {
-    kernel = new WindowedFeatureKernel(reqs, length, hop, cols);
+    return new WindowedFeatureKernel(reqs, length, hop, cols);
   } catch (e) {
     throw new BlockConfigError(`cannot create the feature kernel: ${errorMessage(e)}`, "Window");
   }
-  return {
-    process(f: Frame) {
-      const n = f.n;
-      if (n === 0) return;
-      const k = kernel.push(f.v, n);
-      if (k === 0) return;
-      const o = out.frame(k);
-      kernel.read(o.v, k);
-      const ft = f.t;
-      for (let i = 0; i < k; i++) o.t[i] = ft[kernel.end(i)]!;
-      out.emit(o);
-    },
-    reset() {
-      kernel.reset();
-    },
-    setParam(name, value) {
-      Object.assign(current, { [name]: value });
-      kernel.setThresholds(requests(current));
-    },
-    dispose() {
-      kernel.dispose();
-    },
-  };
+}
+
+/** A feature block on window matrices [L, C]: one output per window, a new kernel on setParam. */
+class WindowMatrixRun<P extends WindowingParams> {
+  private kernel: FeatureKernel;
+
+  constructor(
+    private readonly rows: number,
+    private readonly cols: number,
+    private readonly current: P,
+    private readonly requests: (p: P) => FeatureRequest[],
+    private readonly out: OutputPort,
+  ) {
+    this.kernel = this.build(current);
+  }
+
+  /** The block instance the engine drives (no reset: it holds no history). */
+  instance(): BlockInstance {
+    return {
+      process: (f) => this.process(f),
+      setParam: (name, value) => this.setParam(name, value),
+      dispose: () => this.kernel.dispose(),
+    };
+  }
+
+  /** A kernel for the features of params `q`, its failure a config error. */
+  private build(q: P): FeatureKernel {
+    try {
+      return new FeatureKernel(this.requests(q), this.rows, this.cols);
+    } catch (e) {
+      throw new BlockConfigError(`cannot create the feature kernel: ${errorMessage(e)}`);
+    }
+  }
+
+  /** One output per window, stamped with the window's time. */
+  private process(f: Frame): void {
+    const n = f.n;
+    if (n === 0) return;
+    const o = this.out.frame(n);
+    const ft = f.t;
+    for (let e = 0; e < n; e++) o.t[e] = ft[e]!;
+    this.kernel.process(f.v, o.v, n);
+    this.out.emit(o);
+  }
+
+  /** Swaps in a kernel built for the new params; the params change only once it is built. */
+  private setParam(name: string, value: unknown): void {
+    const next = { ...this.current, [name]: value };
+    const k = this.build(next);
+    this.kernel.dispose();
+    this.kernel = k;
+    Object.assign(this.current, next);
+  }
+}
+
+/** A feature block windowing a plain stream [1, C] itself: an output every Hop samples. */
+class StreamRun<P extends WindowingParams> {
+  constructor(
+    private readonly kernel: WindowedFeatureKernel,
+    private readonly current: P,
+    private readonly requests: (p: P) => FeatureRequest[],
+    private readonly out: OutputPort,
+  ) {}
+
+  /** The block instance the engine drives. */
+  instance(): BlockInstance {
+    return {
+      process: (f) => this.process(f),
+      reset: () => this.kernel.reset(),
+      setParam: (name, value) => this.setParam(name, value),
+      dispose: () => this.kernel.dispose(),
+    };
+  }
+
+  /** Pushes the samples; emits each completed window, stamped with its newest sample's time. */
+  private process(f: Frame): void {
+    const n = f.n;
+    if (n === 0) return;
+    const kernel = this.kernel;
+    const k = kernel.push(f.v, n);
+    if (k === 0) return;
+    const o = this.out.frame(k);
+    kernel.read(o.v, k);
+    const ft = f.t;
+    for (let i = 0; i < k; i++) o.t[i] = ft[kernel.end(i)]!;
+    this.out.emit(o);
+  }
+
+  /** Live thresholds: the kernel keeps its window history. */
+  private setParam(name: string, value: unknown): void {
+    Object.assign(this.current, { [name]: value });
+    this.kernel.setThresholds(this.requests(this.current));
+  }
 }

@@ -5,6 +5,9 @@ import {
   LegacyParamsError,
   legacyInteger,
   type BlockContext,
+  type BlockInstance,
+  type Frame,
+  type UdpBridge,
   type UdpSocketHandle,
 } from "../../engine";
 import { ACTUATION_SIZE, controlInput, describeControl, toActuation } from "../control/actuation";
@@ -46,6 +49,15 @@ const params = z.strictObject({
     ),
 });
 
+/** The raw-EMG or ARV input, with its datagram size in bytes. */
+interface StreamInput {
+  input: SignalInput;
+  bytes: number;
+}
+
+/** What the control input carries, as controlInput found it. */
+type Control = ReturnType<typeof controlInput>;
+
 /** The optional raw-EMG or ARV input, with its datagram size in bytes. */
 function streamInput(
   ctx: BlockContext,
@@ -53,7 +65,7 @@ function streamInput(
   given: number | undefined,
   perValue: number,
   param: string,
-): { input: SignalInput; bytes: number } | null {
+): StreamInput | null {
   if (ctx.inputs.length <= index) {
     if (given !== undefined) {
       throw new BlockConfigError(
@@ -128,95 +140,142 @@ export const HannesGUI = defineBlock({
     const raw = streamInput(ctx, 1, p.RawEmgBytes, 1, "RawEmgBytes");
     const arv = streamInput(ctx, 2, p.ArvBytes, 8, "ArvBytes");
     if (ctx.declaredRate === undefined) ctx.setDesiredRate(0);
-    const dest = endpointText(p.Host, p.Port);
-    const act = new Float64Array(ACTUATION_SIZE);
-    const warns = new WarnLimiter(ctx);
-    const throttle = new TextThrottle();
-    const reads = describeControl(control);
-    const counts = [0, 0, 0];
-    let failed = 0;
-    let notSent = 0;
-    let lastError = "";
-    let socket: UdpSocketHandle | undefined;
-    const bridge = udpBridge(ctx);
-    const describe = (): void => {
-      if (!bridge) {
-        ctx.setText(`${NO_UDP}: ${plural(notSent, "event")} not sent`);
-        return;
-      }
-      let s = `→ ${dest}, ${reads}: ${plural(counts[0]!, "activation")}`;
-      if (raw) s += `, ${plural(counts[1]!, "raw EMG datagram")}`;
-      if (arv) s += `, ${plural(counts[2]!, "ARV datagram")}`;
-      if (failed > 0) s += `; ${failed} failed (${lastError})`;
-      ctx.setText(s);
-    };
-    if (bridge) describe();
-    const onError = (message: string): void => {
-      failed++;
-      lastError = message;
-      warns.warn(`UDP to ${dest}: ${message}`);
-      describe();
-    };
-    const close = (): void => {
-      const s = socket;
-      socket = undefined;
-      s?.close();
-    };
-
-    return {
-      start() {
-        if (!bridge) {
-          ctx.warn(`${NO_UDP}: the Hannes GUI gets nothing`);
-          return;
-        }
-        if (socket) return;
-        try {
-          socket = bridge.open({ remote: { host: p.Host, port: p.Port }, onError });
-        } catch (e) {
-          onError(e instanceof Error ? e.message : String(e));
-        }
-      },
-      process(f, port) {
-        const n = f.n;
-        if (n === 0) return;
-        const s = socket;
-        if (!s) {
-          notSent += n;
-          if (throttle.due(f.t[n - 1]!)) describe();
-          return;
-        }
-        const v = f.v;
-        for (let e = 0; e < n; e++) {
-          if (port === 0) {
-            toActuation(control, v, e, act);
-            for (const d of guiActivations(act)) s.send(d);
-            counts[0] = counts[0]! + 3;
-          } else if (port === 1 && raw) {
-            s.send(guiRawEmg(v, e * raw.input.size, raw.input.size, raw.bytes));
-            counts[1] = counts[1]! + 1;
-          } else if (port === 2 && arv) {
-            s.send(guiArv(v, e * arv.input.size, arv.input.size, arv.bytes));
-            counts[2] = counts[2]! + 1;
-          }
-        }
-        if (throttle.due(f.t[n - 1]!)) describe();
-      },
-      stop() {
-        close();
-        describe();
-      },
-      reset() {
-        counts.fill(0);
-        failed = 0;
-        notSent = 0;
-        lastError = "";
-        throttle.reset();
-        warns.reset();
-        describe();
-      },
-      dispose() {
-        close();
-      },
-    };
+    return new HannesGuiRun(ctx, p.Host, p.Port, control, raw, arv).instance();
   },
 });
+
+/** One HannesGUI at run time: the socket, the datagrams per event, the counts and the status. */
+class HannesGuiRun {
+  private readonly dest: string;
+  private readonly act = new Float64Array(ACTUATION_SIZE);
+  private readonly warns: WarnLimiter;
+  private readonly throttle = new TextThrottle();
+  private readonly reads: string;
+  /** Datagrams sent: activations, raw EMG, ARV. */
+  private readonly counts = [0, 0, 0];
+  private failed = 0;
+  private notSent = 0;
+  private lastError = "";
+  private socket: UdpSocketHandle | undefined;
+  /** Undefined: UDP is unavailable here (udpBridge has said so in the status). */
+  private readonly bridge: UdpBridge | undefined;
+
+  constructor(
+    private readonly ctx: BlockContext,
+    private readonly host: string,
+    private readonly port: number,
+    private readonly control: Control,
+    private readonly raw: StreamInput | null,
+    private readonly arv: StreamInput | null,
+  ) {
+    this.dest = endpointText(host, port);
+    this.warns = new WarnLimiter(ctx);
+    this.reads = describeControl(control);
+    this.bridge = udpBridge(ctx);
+    if (this.bridge) this.describe();
+  }
+
+  /** The block instance the engine drives. */
+  instance(): BlockInstance {
+    return {
+      start: () => this.start(),
+      process: (f, port) => this.process(f, port),
+      stop: () => {
+        this.close();
+        this.describe();
+      },
+      reset: () => this.reset(),
+      dispose: () => this.close(),
+    };
+  }
+
+  /** Opens the socket (once), or warns that without UDP the GUI gets nothing. */
+  private start(): void {
+    if (!this.bridge) {
+      this.ctx.warn(`${NO_UDP}: the Hannes GUI gets nothing`);
+      return;
+    }
+    if (this.socket) return;
+    try {
+      this.socket = this.bridge.open({
+        remote: { host: this.host, port: this.port },
+        onError: this.onError,
+      });
+    } catch (e) {
+      this.onError(e instanceof Error ? e.message : String(e));
+    }
+  }
+
+  /** Sends each event (none without a socket: counted as not sent); the status at its pace. */
+  private process(f: Frame, port: number): void {
+    const n = f.n;
+    if (n === 0) return;
+    const s = this.socket;
+    if (!s) {
+      this.notSent += n;
+      if (this.throttle.due(f.t[n - 1]!)) this.describe();
+      return;
+    }
+    const v = f.v;
+    for (let e = 0; e < n; e++) this.sendEvent(s, port, v, e);
+    if (this.throttle.due(f.t[n - 1]!)) this.describe();
+  }
+
+  /** Event e of input `port`: three activation datagrams, a raw-EMG or an ARV datagram. */
+  private sendEvent(s: UdpSocketHandle, port: number, v: Float64Array, e: number): void {
+    const counts = this.counts;
+    const raw = this.raw;
+    const arv = this.arv;
+    if (port === 0) {
+      toActuation(this.control, v, e, this.act);
+      for (const d of guiActivations(this.act)) s.send(d);
+      counts[0] = counts[0]! + 3;
+    } else if (port === 1 && raw) {
+      s.send(guiRawEmg(v, e * raw.input.size, raw.input.size, raw.bytes));
+      counts[1] = counts[1]! + 1;
+    } else if (port === 2 && arv) {
+      s.send(guiArv(v, e * arv.input.size, arv.input.size, arv.bytes));
+      counts[2] = counts[2]! + 1;
+    }
+  }
+
+  /** Counts a failed send or open, warns (rate-limited) and shows it. */
+  private readonly onError = (message: string): void => {
+    this.failed++;
+    this.lastError = message;
+    this.warns.warn(`UDP to ${this.dest}: ${message}`);
+    this.describe();
+  };
+
+  /** Zeroes the counts, the status throttle and the warning limiter, and shows the status. */
+  private reset(): void {
+    this.counts.fill(0);
+    this.failed = 0;
+    this.notSent = 0;
+    this.lastError = "";
+    this.throttle.reset();
+    this.warns.reset();
+    this.describe();
+  }
+
+  /** The status: the destination, what the input carries, datagrams per kind and failures. */
+  private describe(): void {
+    if (!this.bridge) {
+      this.ctx.setText(`${NO_UDP}: ${plural(this.notSent, "event")} not sent`);
+      return;
+    }
+    const counts = this.counts;
+    let s = `→ ${this.dest}, ${this.reads}: ${plural(counts[0]!, "activation")}`;
+    if (this.raw) s += `, ${plural(counts[1]!, "raw EMG datagram")}`;
+    if (this.arv) s += `, ${plural(counts[2]!, "ARV datagram")}`;
+    if (this.failed > 0) s += `; ${this.failed} failed (${this.lastError})`;
+    this.ctx.setText(s);
+  }
+
+  /** Closes the socket, if open (a send error arriving meanwhile finds none). */
+  private close(): void {
+    const s = this.socket;
+    this.socket = undefined;
+    s?.close();
+  }
+}
