@@ -6,11 +6,8 @@ import {
   legacyInteger,
   vectorShape,
   type BlockContext,
-  type BlockInstance,
   type Frame,
   type OutputPort,
-  type UdpBridge,
-  type UdpSocketHandle,
 } from "../../engine";
 import {
   ACTUATION_SIZE,
@@ -20,9 +17,10 @@ import {
   type ControlKind,
 } from "../control/actuation";
 import { inputName, vectorInput } from "../shared/inputs";
-import { plural, TextThrottle } from "../shared/text";
+import { plural } from "../shared/text";
 import { asciiBytes, BLENDER_SIZE, blenderCommand, blenderText } from "./blender-format";
-import { endpointText, hostParam, portParam, udpBridge, WarnLimiter, NO_UDP } from "./udp-common";
+import { hostParam, portParam, NO_UDP } from "./udp-common";
+import { UdpOutputRun } from "./udp-output-run";
 
 const params = z.strictObject({
   Host: hostParam("The computer running the Blender scene: an IP address or host name"),
@@ -110,69 +108,27 @@ export const BlenderArm = defineBlock({
   },
 });
 
-/** One BlenderArm at run time: the socket, one datagram per event, the counts and the status. */
-class BlenderArmRun {
-  private socket: UdpSocketHandle | undefined;
+/** One BlenderArm at run time: one datagram per event, the count and the status. */
+class BlenderArmRun extends UdpOutputRun {
   private sent = 0;
-  private failed = 0;
-  private notSent = 0;
-  private lastError = "";
-  private readonly dest: string;
   private readonly act = new Float64Array(ACTUATION_SIZE);
   private readonly cmd = new Float64Array(BLENDER_SIZE);
-  private readonly warns: WarnLimiter;
-  private readonly throttle = new TextThrottle();
   private readonly reads: string;
-  /** Undefined: UDP is unavailable here (udpBridge has said so in the status). */
-  private readonly bridge: UdpBridge | undefined;
 
   constructor(
-    private readonly ctx: BlockContext,
-    private readonly host: string,
-    private readonly port: number,
+    ctx: BlockContext,
+    host: string,
+    port: number,
     private readonly control: Control,
     private readonly out: OutputPort,
   ) {
-    this.dest = endpointText(host, port);
-    this.warns = new WarnLimiter(ctx);
+    super(ctx, host, port, "the Blender arm");
     this.reads = describeControl(control);
-    this.bridge = udpBridge(ctx);
     if (this.bridge) this.describe();
   }
 
-  /** The block instance the engine drives. */
-  instance(): BlockInstance {
-    return {
-      start: () => this.start(),
-      process: (f) => this.process(f),
-      stop: () => {
-        this.close();
-        this.describe();
-      },
-      reset: () => this.reset(),
-      dispose: () => this.close(),
-    };
-  }
-
-  /** Opens the socket (once), or warns that without UDP the arm gets nothing. */
-  private start(): void {
-    if (!this.bridge) {
-      this.ctx.warn(`${NO_UDP}: the Blender arm gets nothing`);
-      return;
-    }
-    if (this.socket) return;
-    try {
-      this.socket = this.bridge.open({
-        remote: { host: this.host, port: this.port },
-        onError: this.onError,
-      });
-    } catch (e) {
-      this.onError(e instanceof Error ? e.message : String(e));
-    }
-  }
-
   /** Emits each event's command on `command` and sends it; the status at the throttle's pace. */
-  private process(f: Frame): void {
+  protected process(f: Frame): void {
     const n = f.n;
     if (n === 0) return;
     const o = this.out.frame(n);
@@ -205,39 +161,17 @@ class BlenderArmRun {
     } else this.notSent++;
   }
 
-  /** Counts a failed send or open, warns (rate-limited) and shows it. */
-  private readonly onError = (message: string): void => {
-    this.failed++;
-    this.lastError = message;
-    this.warns.warn(`UDP to ${this.dest}: ${message}`);
-    this.describe();
-  };
-
-  /** Zeroes the counts, the status throttle and the warning limiter, and shows the status. */
-  private reset(): void {
+  protected clearCounts(): void {
     this.sent = 0;
-    this.failed = 0;
-    this.notSent = 0;
-    this.lastError = "";
-    this.throttle.reset();
-    this.warns.reset();
-    this.describe();
   }
 
   /** The status: the destination, what the input carries, datagrams sent and failed. */
-  private describe(): void {
+  protected describe(): void {
     if (!this.bridge) {
       this.ctx.setText(`${NO_UDP}: ${plural(this.notSent, "command")} not sent`);
       return;
     }
     const err = this.failed > 0 ? `, ${this.failed} failed (${this.lastError})` : "";
     this.ctx.setText(`→ ${this.dest}, ${this.reads}: ${plural(this.sent, "datagram")} sent${err}`);
-  }
-
-  /** Closes the socket, if open (a send error arriving meanwhile finds none). */
-  private close(): void {
-    const s = this.socket;
-    this.socket = undefined;
-    s?.close();
   }
 }

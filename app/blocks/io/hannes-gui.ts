@@ -5,16 +5,15 @@ import {
   LegacyParamsError,
   legacyInteger,
   type BlockContext,
-  type BlockInstance,
   type Frame,
-  type UdpBridge,
   type UdpSocketHandle,
 } from "../../engine";
 import { ACTUATION_SIZE, controlInput, describeControl, toActuation } from "../control/actuation";
 import { inputName, vectorInput, type SignalInput } from "../shared/inputs";
-import { plural, TextThrottle } from "../shared/text";
+import { plural } from "../shared/text";
 import { guiActivations, guiArv, guiRawEmg } from "./hannes-protocol";
-import { endpointText, hostParam, portParam, udpBridge, WarnLimiter, NO_UDP } from "./udp-common";
+import { hostParam, portParam, NO_UDP } from "./udp-common";
+import { UdpOutputRun } from "./udp-output-run";
 
 const params = z.strictObject({
   Host: hostParam("The computer running IIT's Hannes GUI (the virtual arm)"),
@@ -144,70 +143,28 @@ export const HannesGUI = defineBlock({
   },
 });
 
-/** One HannesGUI at run time: the socket, the datagrams per event, the counts and the status. */
-class HannesGuiRun {
-  private readonly dest: string;
+/** One HannesGUI at run time: the datagrams per event, their counts and the status. */
+class HannesGuiRun extends UdpOutputRun {
   private readonly act = new Float64Array(ACTUATION_SIZE);
-  private readonly warns: WarnLimiter;
-  private readonly throttle = new TextThrottle();
   private readonly reads: string;
   /** Datagrams sent: activations, raw EMG, ARV. */
   private readonly counts = [0, 0, 0];
-  private failed = 0;
-  private notSent = 0;
-  private lastError = "";
-  private socket: UdpSocketHandle | undefined;
-  /** Undefined: UDP is unavailable here (udpBridge has said so in the status). */
-  private readonly bridge: UdpBridge | undefined;
 
   constructor(
-    private readonly ctx: BlockContext,
-    private readonly host: string,
-    private readonly port: number,
+    ctx: BlockContext,
+    host: string,
+    port: number,
     private readonly control: Control,
     private readonly raw: StreamInput | null,
     private readonly arv: StreamInput | null,
   ) {
-    this.dest = endpointText(host, port);
-    this.warns = new WarnLimiter(ctx);
+    super(ctx, host, port, "the Hannes GUI");
     this.reads = describeControl(control);
-    this.bridge = udpBridge(ctx);
     if (this.bridge) this.describe();
   }
 
-  /** The block instance the engine drives. */
-  instance(): BlockInstance {
-    return {
-      start: () => this.start(),
-      process: (f, port) => this.process(f, port),
-      stop: () => {
-        this.close();
-        this.describe();
-      },
-      reset: () => this.reset(),
-      dispose: () => this.close(),
-    };
-  }
-
-  /** Opens the socket (once), or warns that without UDP the GUI gets nothing. */
-  private start(): void {
-    if (!this.bridge) {
-      this.ctx.warn(`${NO_UDP}: the Hannes GUI gets nothing`);
-      return;
-    }
-    if (this.socket) return;
-    try {
-      this.socket = this.bridge.open({
-        remote: { host: this.host, port: this.port },
-        onError: this.onError,
-      });
-    } catch (e) {
-      this.onError(e instanceof Error ? e.message : String(e));
-    }
-  }
-
   /** Sends each event (none without a socket: counted as not sent); the status at its pace. */
-  private process(f: Frame, port: number): void {
+  protected process(f: Frame, port: number): void {
     const n = f.n;
     if (n === 0) return;
     const s = this.socket;
@@ -239,27 +196,12 @@ class HannesGuiRun {
     }
   }
 
-  /** Counts a failed send or open, warns (rate-limited) and shows it. */
-  private readonly onError = (message: string): void => {
-    this.failed++;
-    this.lastError = message;
-    this.warns.warn(`UDP to ${this.dest}: ${message}`);
-    this.describe();
-  };
-
-  /** Zeroes the counts, the status throttle and the warning limiter, and shows the status. */
-  private reset(): void {
+  protected clearCounts(): void {
     this.counts.fill(0);
-    this.failed = 0;
-    this.notSent = 0;
-    this.lastError = "";
-    this.throttle.reset();
-    this.warns.reset();
-    this.describe();
   }
 
   /** The status: the destination, what the input carries, datagrams per kind and failures. */
-  private describe(): void {
+  protected describe(): void {
     if (!this.bridge) {
       this.ctx.setText(`${NO_UDP}: ${plural(this.notSent, "event")} not sent`);
       return;
@@ -270,12 +212,5 @@ class HannesGuiRun {
     if (this.arv) s += `, ${plural(counts[2]!, "ARV datagram")}`;
     if (this.failed > 0) s += `; ${this.failed} failed (${this.lastError})`;
     this.ctx.setText(s);
-  }
-
-  /** Closes the socket, if open (a send error arriving meanwhile finds none). */
-  private close(): void {
-    const s = this.socket;
-    this.socket = undefined;
-    s?.close();
   }
 }
