@@ -4,35 +4,17 @@ import { afterEach, describe, expect, test, vi } from "vitest";
 import type { Reply } from "../client/engine-client";
 import type { EngineClient } from "../client/engine-client";
 import { EngineContext } from "../client/hooks";
+import { created, withHandler } from "../test-support/jsx-spy";
 import { OpenLocal } from "./open-local";
 
-/** The props of every DOM element rendered with an onChange (the file inputs), in order. */
-const { inputs, capture } = vi.hoisted(() => {
-  const inputs: { onChange(e: unknown): void }[] = [];
-  const capture =
-    (jsx: (...a: unknown[]) => unknown) =>
-    (type: unknown, props: { onChange?: unknown }, ...rest: unknown[]) => {
-      if (typeof type === "string" && props?.onChange)
-        inputs.push(props as { onChange(e: unknown): void });
-      return jsx(type, props, ...rest);
-    };
-  return { inputs, capture };
-});
-vi.mock("react/jsx-dev-runtime", async (orig) => {
-  const m = await orig<typeof import("react/jsx-dev-runtime")>();
-  return { ...m, jsxDEV: capture(m.jsxDEV as (...a: unknown[]) => unknown) };
-});
-vi.mock("react/jsx-runtime", async (orig) => {
-  const m = await orig<typeof import("react/jsx-runtime")>();
-  return {
-    ...m,
-    jsx: capture(m.jsx as (...a: unknown[]) => unknown),
-    jsxs: capture(m.jsxs as (...a: unknown[]) => unknown),
-  };
-});
-
+vi.mock("react/jsx-runtime", async (orig) =>
+  (await import("../test-support/jsx-spy")).spyJsx(await orig<object>()),
+);
+vi.mock("react/jsx-dev-runtime", async (orig) =>
+  (await import("../test-support/jsx-spy")).spyJsx(await orig<object>()),
+);
 afterEach(() => {
-  inputs.length = 0;
+  created.length = 0;
 });
 
 /** Renders OpenLocal; `log` gets every call to the engine, onOpen and notify, in order. */
@@ -54,7 +36,7 @@ function render(inPage: boolean, reply: Reply = { ok: true } as Reply) {
       createElement(OpenLocal, { inPage, onOpen, notify }),
     ),
   );
-  return { html, log, input: [...inputs] };
+  return { html, log, input: withHandler("onChange") };
 }
 
 const file = (path: string, text: string): File => {

@@ -4,34 +4,18 @@ import { afterEach, describe, expect, test, vi } from "vitest";
 import type { BlockInfo, BlockTypeInfo } from "../../engine/protocol";
 import type { EngineClient } from "../client/engine-client";
 import { EngineContext } from "../client/hooks";
+import { components, created } from "../test-support/jsx-spy";
 import { Inspector, type InspectorProps } from "./inspector";
 import type { EditBlock, EditIssue } from "./model";
 
-/** The props of every component element rendered (its name and props), in order. */
-const { parts, capture } = vi.hoisted(() => {
-  const parts: [string, Record<string, unknown>][] = [];
-  const capture =
-    (jsx: (...a: unknown[]) => unknown) =>
-    (type: unknown, props: Record<string, unknown>, ...rest: unknown[]) => {
-      if (typeof type === "function") parts.push([type.name, props]);
-      return jsx(type, props, ...rest);
-    };
-  return { parts, capture };
-});
-vi.mock("react/jsx-dev-runtime", async (orig) => {
-  const m = await orig<typeof import("react/jsx-dev-runtime")>();
-  return { ...m, jsxDEV: capture(m.jsxDEV as (...a: unknown[]) => unknown) };
-});
-vi.mock("react/jsx-runtime", async (orig) => {
-  const m = await orig<typeof import("react/jsx-runtime")>();
-  return {
-    ...m,
-    jsx: capture(m.jsx as (...a: unknown[]) => unknown),
-    jsxs: capture(m.jsxs as (...a: unknown[]) => unknown),
-  };
-});
+vi.mock("react/jsx-runtime", async (orig) =>
+  (await import("../test-support/jsx-spy")).spyJsx(await orig<object>()),
+);
+vi.mock("react/jsx-dev-runtime", async (orig) =>
+  (await import("../test-support/jsx-spy")).spyJsx(await orig<object>()),
+);
 afterEach(() => {
-  parts.length = 0;
+  created.length = 0;
 });
 
 const block = (over: Partial<EditBlock> = {}): EditBlock => ({
@@ -108,7 +92,7 @@ function render(
 
 /** The CommitField rendered with that label. */
 const field = (label: string) =>
-  parts.find(([n, p]) => n === "CommitField" && p.label === label)![1] as {
+  components().find(([n, p]) => n === "CommitField" && p.label === label)![1] as {
     value: string;
     placeholder?: string;
     hint?: string;
@@ -176,10 +160,10 @@ describe("Inspector markup", () => {
     render({ type: type({ inputs: { min: 1, max: 3, labels: [] } }) });
     expect(field("Inputs").hint).toMatch(/^1–3 input\(s\)/);
     expect(field("Inputs").placeholder).toBe("e.g. Timer, Emg");
-    parts.length = 0;
+    created.length = 0;
     render({ type: type({ inputs: { min: 2, max: null, labels: [] } }) });
     expect(field("Inputs").hint).toMatch(/^2\+ input\(s\)/);
-    parts.length = 0;
+    created.length = 0;
     render({ type: undefined });
     expect(field("Inputs").hint).toBeUndefined();
     expect(field("Inputs").placeholder).toBe("e.g. Timer, Emg");
@@ -187,7 +171,7 @@ describe("Inspector markup", () => {
   });
   test("the form gets the block as the engine would list it", () => {
     render();
-    const form = parts.find(([n]) => n === "ParamsForm")![1];
+    const form = components().find(([n]) => n === "ParamsForm")![1];
     expect(form.engineState).toBe("loaded");
     expect(form.block).toEqual({
       name: "Filter",
@@ -260,7 +244,7 @@ describe("Inspector callbacks", () => {
   });
   test("the form's live and static changes both go to onParam", async () => {
     const { log } = render();
-    const form = parts.find(([n]) => n === "ParamsForm")![1] as {
+    const form = components().find(([n]) => n === "ParamsForm")![1] as {
       onSet(p: string, v: unknown): Promise<unknown>;
       onEditStatic(p: string, v: unknown): Promise<unknown>;
     };

@@ -6,34 +6,17 @@ import type { BlockInfo } from "../../engine/protocol";
 import type { Telemetry } from "../../engine/runtime/runtime";
 import type { EngineClient } from "../client/engine-client";
 import { EngineContext } from "../client/hooks";
+import { created, withHandler } from "../test-support/jsx-spy";
 import { BlockNode as RealBlockNode, GraphStateContext, type GraphState } from "./block-node";
 
-/** The props of every DOM element rendered with an onClick (the menu button), in order. */
-const { clicks, capture } = vi.hoisted(() => {
-  const clicks: { onClick(e: unknown): void }[] = [];
-  const capture =
-    (jsx: (...a: unknown[]) => unknown) =>
-    (type: unknown, props: { onClick?: unknown }, ...rest: unknown[]) => {
-      if (typeof type === "string" && props?.onClick)
-        clicks.push(props as { onClick(e: unknown): void });
-      return jsx(type, props, ...rest);
-    };
-  return { clicks, capture };
-});
-vi.mock("react/jsx-dev-runtime", async (orig) => {
-  const m = await orig<typeof import("react/jsx-dev-runtime")>();
-  return { ...m, jsxDEV: capture(m.jsxDEV as (...a: unknown[]) => unknown) };
-});
-vi.mock("react/jsx-runtime", async (orig) => {
-  const m = await orig<typeof import("react/jsx-runtime")>();
-  return {
-    ...m,
-    jsx: capture(m.jsx as (...a: unknown[]) => unknown),
-    jsxs: capture(m.jsxs as (...a: unknown[]) => unknown),
-  };
-});
+vi.mock("react/jsx-runtime", async (orig) =>
+  (await import("../test-support/jsx-spy")).spyJsx(await orig<object>()),
+);
+vi.mock("react/jsx-dev-runtime", async (orig) =>
+  (await import("../test-support/jsx-spy")).spyJsx(await orig<object>()),
+);
 afterEach(() => {
-  clicks.length = 0;
+  created.length = 0;
 });
 
 /** The node's props as the tests give them (React Flow passes many more, which it does not read). */
@@ -151,6 +134,7 @@ describe("BlockNode markup", () => {
   test("the menu button opens the block's actions below itself, and the click stops there", () => {
     const log: unknown[] = [];
     render(block(), { onMenu: (name, at) => log.push(["menu", name, at]) });
+    const clicks = withHandler("onClick");
     expect(clicks).toHaveLength(1);
     clicks[0]!.onClick({
       stopPropagation: () => log.push(["stop"]),
@@ -160,6 +144,6 @@ describe("BlockNode markup", () => {
   });
   test("in edit mode there is no menu button", () => {
     render(block(), { edit: { issues: [] } });
-    expect(clicks).toHaveLength(0);
+    expect(withHandler("onClick")).toHaveLength(0);
   });
 });
