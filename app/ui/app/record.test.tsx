@@ -4,6 +4,7 @@ import { afterEach, describe, expect, test, vi } from "vitest";
 import type { GraphInfo, RecordingStatus } from "../../engine/protocol";
 import type { EngineClient, Reply } from "../client/engine-client";
 import { EngineContext } from "../client/hooks";
+import { clearHooks, hooks } from "../test-support/jsx-spy";
 import { RecordControl } from "./record";
 
 /** A DOM element's props as the tests call them. */
@@ -13,15 +14,11 @@ type Props = Record<string, unknown> & { className?: string; type?: string };
  * The props of every DOM element rendered (tag and props, in order), and what the tests do while
  * it renders: the first element an action matches gets it at once, as a click in the page would
  * (a state update while rendering: the server renderer renders the component again with it).
- * Also every effect (the server renderer runs none: the tests run them), every state update
- * (those after rendering change nothing there) and initial states to start with instead.
+ * Effects, state updates and initial states are in jsx-spy's `hooks`.
  */
 const spy = vi.hoisted(() => {
   const elements: [string, Props][] = [];
   const actions: { match(tag: string, p: Props): boolean; act(p: Props): void }[] = [];
-  const effects: (() => void | (() => void))[] = [];
-  const updates: unknown[] = [];
-  const initial = new Map<unknown, unknown>();
   const capture =
     (jsx: (...a: unknown[]) => unknown) =>
     (type: unknown, props: Props, ...rest: unknown[]) => {
@@ -32,7 +29,7 @@ const spy = vi.hoisted(() => {
       }
       return jsx(type, props, ...rest);
     };
-  return { elements, actions, effects, updates, initial, capture };
+  return { elements, actions, capture };
 });
 vi.mock("react/jsx-dev-runtime", async (orig) => {
   const m = await orig<typeof import("react/jsx-dev-runtime")>();
@@ -46,32 +43,13 @@ vi.mock("react/jsx-runtime", async (orig) => {
     jsxs: spy.capture(m.jsxs as (...a: unknown[]) => unknown),
   };
 });
-vi.mock("react", async (orig) => {
-  const m = await orig<typeof import("react")>();
-  return {
-    ...m,
-    useEffect: (fn: () => void | (() => void), deps?: unknown[]) => {
-      spy.effects.push(fn);
-      m.useEffect(fn, deps);
-    },
-    useState: <S,>(init: S | (() => S)) => {
-      const [s, set] = m.useState(spy.initial.has(init) ? (spy.initial.get(init) as S) : init);
-      return [
-        s,
-        (v: unknown) => {
-          spy.updates.push(v);
-          set(v as S);
-        },
-      ];
-    },
-  };
-});
+vi.mock("react", async (orig) =>
+  (await import("../test-support/jsx-spy")).spyReact(await orig<typeof import("react")>()),
+);
 afterEach(() => {
   spy.elements.length = 0;
   spy.actions.length = 0;
-  spy.effects.length = 0;
-  spy.updates.length = 0;
-  spy.initial.clear();
+  clearHooks();
 });
 
 const out = (name: string, rows: number, cols: number) => ({ name, shape: { rows, cols } });
@@ -206,7 +184,7 @@ describe("RecordControl markup", () => {
 describe("RecordControl actions", () => {
   test("it follows the engine's recording status, and stops following", () => {
     const { log } = render();
-    const cleanups = spy.effects.map((fn) => fn());
+    const cleanups = hooks.effects.map((fn) => fn());
     expect(log).toEqual([["onRecording", "function"]]);
     for (const c of cleanups) if (typeof c === "function") c();
     expect(log).toEqual([["onRecording", "function"], ["offRecording"]]);
@@ -255,21 +233,21 @@ describe("RecordControl dialog", () => {
       open: false,
       showModal: () => calls.push("showModal"),
     };
-    for (const fn of spy.effects) fn();
+    for (const fn of hooks.effects) fn();
     expect(calls).toEqual(["showModal"]);
   });
   test("picking outputs and a format updates what is checked", () => {
     openDialog();
     const { elements } = render();
-    spy.updates.length = 0;
+    hooks.updates.length = 0;
     const boxes = elements.filter(([t, p]) => t === "input" && p.type === "checkbox");
     expect(boxes.map(([, p]) => p.checked)).toEqual([true, true, false, false]);
     (boxes[0]![1].onChange as (e: unknown) => void)({ target: { checked: false } });
     (boxes[2]![1].onChange as (e: unknown) => void)({ target: { checked: true } });
     (the(elements, "input", (p) => p.value === "bdf").onChange as () => void)();
-    expect(spy.updates).toHaveLength(3);
+    expect(hooks.updates).toHaveLength(3);
     type Toggle = (s: Set<string>) => Set<string>;
-    const [off, on, format] = spy.updates as [Toggle, Toggle, string];
+    const [off, on, format] = hooks.updates as [Toggle, Toggle, string];
     const before = new Set(["Emg", "Emg.imu"]);
     expect([...off(before)]).toEqual(["Emg.imu"]);
     expect([...on(before)]).toEqual(["Emg", "Emg.imu", "Filter"]);
@@ -313,7 +291,7 @@ describe("RecordControl dialog", () => {
   });
   test("the format picked is sent", async () => {
     openDialog();
-    spy.initial.set("xdf", "edf");
+    hooks.initial.set("xdf", "edf");
     const { log, elements, html } = render({ reply: { ok: false } as Reply });
     expect(html).toMatch(/checked="" value="edf"/);
     (the(elements, "form").onSubmit as (e: unknown) => void)({ preventDefault: () => {} });

@@ -5,41 +5,23 @@ import type { BlockInfo, DataMessage } from "../../engine/protocol";
 import type { Telemetry } from "../../engine/runtime/runtime";
 import type { EngineClient } from "../client/engine-client";
 import { EngineContext } from "../client/hooks";
+import { clearHooks, hooks } from "../test-support/jsx-spy";
 import { LABELS_MAX, LabelDisplay } from "./labels";
 
 /**
  * What the test sees of the hooks: the data each watched output gets at once (delivered while it
- * renders), every watch asked for, every effect (the server renderer runs none: the tests run
- * them), every state update and every frame task.
+ * renders), every watch asked for and every frame task (effects and state updates: jsx-spy's
+ * `hooks`).
  */
 const spy = vi.hoisted(() => ({
   feed: new Map<string, Partial<DataMessage>[]>(),
   watches: [] as unknown[][],
-  effects: [] as (() => void | (() => void))[],
-  updates: [] as unknown[],
   frames: [] as ((now: number) => void)[],
   log: [] as unknown[],
 }));
-vi.mock("react", async (orig) => {
-  const m = await orig<typeof import("react")>();
-  return {
-    ...m,
-    useEffect: (fn: () => void | (() => void), deps?: unknown[]) => {
-      spy.effects.push(fn);
-      m.useEffect(fn, deps);
-    },
-    useState: <S,>(init: S | (() => S)) => {
-      const [s, set] = m.useState(init);
-      return [
-        s,
-        (v: unknown) => {
-          spy.updates.push(v);
-          set(v as S);
-        },
-      ];
-    },
-  };
-});
+vi.mock("react", async (orig) =>
+  (await import("../test-support/jsx-spy")).spyReact(await orig<typeof import("react")>()),
+);
 vi.mock("../client/hooks", async (orig) => {
   const m = await orig<typeof import("../client/hooks")>();
   return {
@@ -65,8 +47,7 @@ vi.mock("./frame", () => ({
 afterEach(() => {
   spy.feed.clear();
   spy.watches.length = 0;
-  spy.effects.length = 0;
-  spy.updates.length = 0;
+  clearHooks();
   spy.frames.length = 0;
   spy.log.length = 0;
 });
@@ -167,22 +148,22 @@ describe("LabelDisplay refresh", () => {
   test("new data shows at most every 200 ms, on an animation frame", () => {
     spy.feed.set("Lda.out", [data([1], [1])]);
     render(block([{ name: "out", shape: { rows: 1, cols: 1 } }]));
-    const cleanups = spy.effects.map((fn) => fn());
+    const cleanups = hooks.effects.map((fn) => fn());
     expect(spy.frames).toHaveLength(1);
     const frame = spy.frames[0]!;
     frame(100);
-    expect(spy.updates).toHaveLength(0);
+    expect(hooks.updates).toHaveLength(0);
     frame(250);
-    expect(spy.updates).toHaveLength(1);
-    expect((spy.updates[0] as (x: number) => number)(4)).toBe(5);
+    expect(hooks.updates).toHaveLength(1);
+    expect((hooks.updates[0] as (x: number) => number)(4)).toBe(5);
     frame(500);
-    expect(spy.updates).toHaveLength(1);
+    expect(hooks.updates).toHaveLength(1);
     for (const c of cleanups) if (typeof c === "function") c();
     expect(spy.log).toEqual(["frame task removed"]);
   });
   test("hidden: no frame task", () => {
     render(block([{ name: "out", shape: { rows: 1, cols: 1 } }]), false);
-    for (const fn of spy.effects) expect(fn()).toBeUndefined();
+    for (const fn of hooks.effects) expect(fn()).toBeUndefined();
     expect(spy.frames).toHaveLength(0);
   });
 });

@@ -51,3 +51,45 @@ export function components(): [string, Record<string, unknown>][] {
     .filter((c) => typeof c.type === "function")
     .map((c) => [(c.type as { name: string }).name, c.props]);
 }
+
+/**
+ * What a component's hooks did while it rendered: every effect (the server renderer runs none:
+ * the tests run them), every state update (after rendering the server renderer ignores them) and
+ * initial states to start with instead of the component's own (keyed by the component's initial
+ * value). With `vi.mock("react", async (orig) => spyReact(await orig()))` (imported as above).
+ */
+export const hooks = {
+  effects: [] as (() => void | (() => void))[],
+  updates: [] as unknown[],
+  initial: new Map<unknown, unknown>(),
+};
+
+type ReactModule = typeof import("react");
+
+/** React with useEffect and useState recording into `hooks`. */
+export function spyReact(m: ReactModule): ReactModule {
+  return {
+    ...m,
+    useEffect: (fn: () => void | (() => void), deps?: readonly unknown[]) => {
+      hooks.effects.push(fn);
+      m.useEffect(fn, deps);
+    },
+    useState: <S>(init: S | (() => S)) => {
+      const [s, set] = m.useState(hooks.initial.has(init) ? (hooks.initial.get(init) as S) : init);
+      return [
+        s,
+        (v: unknown) => {
+          hooks.updates.push(v);
+          set(v as S);
+        },
+      ];
+    },
+  } as ReactModule;
+}
+
+/** Empties `hooks` (after each test). */
+export function clearHooks(): void {
+  hooks.effects.length = 0;
+  hooks.updates.length = 0;
+  hooks.initial.clear();
+}
