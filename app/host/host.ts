@@ -19,6 +19,7 @@ import type { BleBridge } from "../engine/io";
 import { LogWriter } from "./log-writer";
 import { takeTimeBase, type TimeBase } from "./time-base";
 import { telemetryGroup } from "./telemetry-outbox";
+import { tuneTiering } from "./tiering";
 import {
   DEFAULT_TELEMETRY_HZ,
   type ClockMode,
@@ -324,6 +325,7 @@ export class Host {
   }
 
   private spawn(name: string): WorkerState {
+    tuneTiering();
     const worker = new Worker(this.options.workerPath, {
       name: `mosaic-engine-${name}`,
       // A small young generation keeps the worker's footprint down; its garbage is tiny.

@@ -28,6 +28,7 @@ import { defaultWasmPath } from "./host";
 import { LogWriter } from "./log-writer";
 import type { HubToSession, SessionToHub } from "./session-protocol";
 import { takeTimeBase } from "./time-base";
+import { tuneTiering } from "./tiering";
 
 /** One client of the hub: where its engine messages go. */
 export interface HubClient {
@@ -152,6 +153,7 @@ export class SessionHub {
     this.allowed = options.allowedDirs
       ? new Set(options.allowedDirs.map((d) => resolve(d)))
       : undefined;
+    tuneTiering();
     this.worker = new Worker(options.workerPath ?? defaultSessionWorkerPath(), {
       name: "mosaic-session",
       resourceLimits: { maxYoungGenerationSizeMb: 8 },
