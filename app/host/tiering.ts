@@ -11,7 +11,7 @@
  * block code still ran in the baseline tier, every property access through a generic inline-cache
  * stub; at 90–120 s it still did. With the thresholds below the same code is optimized within
  * the first seconds: the Myo pipeline used 2.40 / 2.44 % of a core against 2.93 / 3.10 % (two
- * pairs side by side, bench/README.md "Tiering").
+ * pairs side by side; README.md, "Performance").
  *
  * The flags are process-wide and must be set before the engine's workers compile their code: the
  * Node host and the session hub call `tuneTiering` before they start a worker. Browsers do not let
