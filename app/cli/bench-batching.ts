@@ -11,18 +11,18 @@ import { pipelineDef, type BatchingDef, type PipelineDef } from "./bench-workloa
 
 export async function runBatching(
   def: BatchingDef,
-  o: Omit<PipelineRunOptions, "batchingMs" | "telemetryHz">,
+  o: Omit<PipelineRunOptions, "batchingMs" | "telemetryHz" | "v8Tiering">,
 ): Promise<BatchingResult> {
   const before = loadAvg();
   const rows: BatchingRow[] = [];
   for (const id of def.pipelines) {
     const p = pipelineDef(id);
     if (!p) continue;
-    for (const ms of def.intervalsMs) {
-      for (const hz of def.telemetryHz ?? [undefined]) {
-        const r = await runPipeline(p, { ...o, batchingMs: ms, telemetryHz: hz });
-        rows.push(sweepRow(p, ms, hz ?? DEFAULT_TELEMETRY_HZ, r));
-      }
+    for (const v of sweepVariants(def)) {
+      const r = await runPipeline(p, { ...o, ...v });
+      const row = sweepRow(p, v.batchingMs, v.telemetryHz ?? DEFAULT_TELEMETRY_HZ, r);
+      if (v.v8Tiering !== undefined) row.v8Tiering = v.v8Tiering;
+      rows.push(row);
     }
   }
   const failed = rows.filter((r) => !r.ok);
@@ -38,11 +38,35 @@ export async function runBatching(
     steadySeconds: o.steady,
     intervalsMs: def.intervalsMs,
     ...(def.telemetryHz ? { telemetryHz: def.telemetryHz } : {}),
+    ...(def.v8Tiering ? { v8Tiering: def.v8Tiering } : {}),
     rows,
     loadAvgBefore: before,
     loadAvgAfter: loadAvg(),
     killedAfterSummary: false,
   };
+}
+
+interface SweepVariant {
+  batchingMs: number;
+  telemetryHz?: number;
+  v8Tiering?: boolean;
+}
+
+/** The runs of a sweep for one pipeline, in order: each interval × telemetry rate × tiering. */
+export function sweepVariants(def: BatchingDef): SweepVariant[] {
+  const out: SweepVariant[] = [];
+  for (const batchingMs of def.intervalsMs) {
+    for (const hz of def.telemetryHz ?? [undefined]) {
+      for (const tiering of def.v8Tiering ?? [undefined]) {
+        out.push({
+          batchingMs,
+          ...(hz !== undefined ? { telemetryHz: hz } : {}),
+          ...(tiering !== undefined ? { v8Tiering: tiering } : {}),
+        });
+      }
+    }
+  }
+  return out;
 }
 
 /**

@@ -16,6 +16,7 @@ import { mean, quantile, std } from "./bench-stats";
 import type { BlockRow, CpuFigures, PipelineResult, TimerFigures } from "./bench-types";
 import { loadAvg, progress, round, sleep } from "./bench-util";
 import type { PipelineDef } from "./bench-workloads";
+import { TIERING_ENV } from "../host/tiering";
 
 export interface PipelineRunOptions {
   cli: string;
@@ -27,6 +28,8 @@ export interface PipelineRunOptions {
   batchingMs?: number;
   /** `--telemetry-hz` for this run (the telemetry sweep). */
   telemetryHz?: number;
+  /** false: the run keeps V8's own tier-up thresholds (the tiering sweep; app/host/tiering.ts). */
+  v8Tiering?: boolean;
 }
 
 /** `inspect` sees the child run before its figures are taken (the soak's own accounting). */
@@ -179,6 +182,7 @@ async function runBeside(
       steadySeconds: o.steady,
       warmup: o.warmup > 0,
       timeoutSeconds: total + 60,
+      ...(o.v8Tiering === false ? { env: { [TIERING_ENV]: "v8" } } : {}),
     });
   } finally {
     const burnt = neighbour?.stop();

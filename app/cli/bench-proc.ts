@@ -116,6 +116,8 @@ export interface ChildOptions {
   /** How long the child may stay alive after its summary before it is terminated, s. */
   lingerLimitSeconds?: number;
   cwd?: string;
+  /** Variables added to the child's environment. */
+  env?: Record<string, string>;
 }
 
 /** Runs `node dist/cli.mjs <args>` and measures it. Never rejects. */
@@ -191,6 +193,7 @@ class ChildMonitor {
     const child = spawn(process.execPath, [o.cli, ...o.args], {
       cwd: o.cwd,
       stdio: ["ignore", "pipe", "pipe"],
+      ...(o.env ? { env: { ...process.env, ...o.env } } : {}),
     });
     this.child = child;
     const pid = (this.pid = child.pid);

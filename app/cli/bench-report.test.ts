@@ -9,7 +9,8 @@ import type {
   PipelineResult,
   UdpRxFigures,
 } from "./bench-types";
-import { selects } from "./bench-workloads";
+import { selects, type BatchingDef } from "./bench-workloads";
+import { sweepVariants } from "./bench-batching";
 
 const row = (name: string, type: string, rate: number): BlockRow => ({
   name,
@@ -261,6 +262,70 @@ describe("bench report", () => {
     );
     expect(batchingMarkdown(abba).join("\n")).toContain("cancels in the mean");
     expect(md).toContain("every pair ran the higher rate first");
+  });
+
+  test("the tiering sweep: runs in turn with V8's thresholds and the engine's, the saving per pair", () => {
+    const row = (engine: boolean, cpu: number): BatchingResult["rows"][number] => ({
+      pipeline: "myo",
+      batchingMs: 5,
+      telemetryHz: 20,
+      v8Tiering: engine,
+      ok: true,
+      cpuMedianPct: cpu,
+      engineWakeupsPerS: 100,
+      sender: null,
+      acquisition: null,
+      udpRateHz: 25,
+      samplesLost: 0,
+      loadAvgBefore: [0.5, 0.4, 0.3],
+    });
+    const order = [false, true, true, false];
+    const r: BatchingResult = {
+      kind: "batching",
+      id: "tiering",
+      title: "V8 tiering",
+      ok: true,
+      warmupSeconds: 15,
+      steadySeconds: 15,
+      intervalsMs: [5],
+      v8Tiering: order,
+      // V8's own thresholds cost 0.6 % more; the load falls by 0.2 % per run.
+      rows: order.map((engine, i) => row(engine, 3 - 0.2 * i + (engine ? 0 : 0.6))),
+      loadAvgBefore: [0.5, 0.4, 0.3],
+      loadAvgAfter: [0.5, 0.4, 0.3],
+      killedAfterSummary: false,
+    };
+    const md = batchingMarkdown(r).join("\n");
+    expect(md).toContain(
+      "with V8's own, the engine's, the engine's, V8's own V8 tier-up thresholds in turn",
+    );
+    expect(md).toContain("| myo (V8's own tiering) | 5 | 20 | 3.60 | 100 |");
+    expect(md).toContain("| myo | 5 | 20 | 2.80 | 100 |");
+    // Pairs: 3.6 − 2.8, 3.0 − 2.6 (V8's own minus the engine's, whichever ran first).
+    expect(md).toContain(
+      "- myo, batching 5 ms: the engine's tier-up thresholds save 0.80, 0.40 % of one core against V8's own in 2 pair(s) of runs (mean 0.60 %, median 0.60 %)",
+    );
+    expect(md).not.toContain("telemetry at 20 Hz instead of");
+  });
+
+  test("a sweep's runs: every interval × telemetry rate × tiering, in order", () => {
+    const def = (extra: Partial<BatchingDef>): BatchingDef => ({
+      kind: "batching",
+      id: "x",
+      title: "x",
+      pipelines: ["myo"],
+      intervalsMs: [0, 5],
+      ...extra,
+    });
+    expect(sweepVariants(def({}))).toEqual([{ batchingMs: 0 }, { batchingMs: 5 }]);
+    expect(sweepVariants(def({ intervalsMs: [5], v8Tiering: [false, true] }))).toEqual([
+      { batchingMs: 5, v8Tiering: false },
+      { batchingMs: 5, v8Tiering: true },
+    ]);
+    expect(sweepVariants(def({ intervalsMs: [5], telemetryHz: [20, 2] }))).toEqual([
+      { batchingMs: 5, telemetryHz: 20 },
+      { batchingMs: 5, telemetryHz: 2 },
+    ]);
   });
 
   test("--only: an id selects that workload alone, a group name or NAME* the group", () => {

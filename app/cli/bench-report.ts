@@ -70,9 +70,12 @@ export function batchingMarkdown(r: BatchingResult, heading = "##"): string[] {
   const telemetry = r.telemetryHz
     ? ` and \`--telemetry-hz\` ${r.telemetryHz.join(", ")} in turn`
     : " and telemetry at 20 Hz";
+  const tiering = r.v8Tiering
+    ? `, with ${r.v8Tiering.map(tieringName).join(", ")} V8 tier-up thresholds in turn`
+    : "";
   return [
     ...section(heading, r.title),
-    `Each pipeline run with \`--batching-ms\` ${r.intervalsMs.join(", ")}${telemetry} (warm-up ` +
+    `Each pipeline run with \`--batching-ms\` ${r.intervalsMs.join(", ")}${telemetry}${tiering} (warm-up ` +
       `${r.warmupSeconds} s, steady state ${r.steadySeconds} s each). CPU: median of 1-s samples, % of ` +
       "one core. Wake-ups: voluntary context switches per second of the busiest thread other than the " +
       "CLI's main thread (the engine worker). Delay: delivery delay p50 / p99 (ms) since the warm-up. " +
@@ -95,7 +98,36 @@ export function batchingMarkdown(r: BatchingResult, heading = "##"): string[] {
     ),
     "",
     ...telemetryCost(r),
+    ...tieringCost(r),
   ];
+}
+
+/** "the engine's" or "V8's own" (a run's tier-up thresholds; app/host/tiering.ts). */
+function tieringName(engine: boolean): string {
+  return engine ? "the engine's" : "V8's own";
+}
+
+/**
+ * The tiering sweep's reading: per pipeline and interval, in each pair of consecutive runs the
+ * CPU median with V8's own thresholds minus that with the engine's (what the engine's save), their
+ * mean and median; the pairs alternate their order, as the telemetry sweep's.
+ */
+function tieringCost(r: BatchingResult): string[] {
+  if (!r.v8Tiering || r.v8Tiering.length < 2) return [];
+  const lines: string[] = [];
+  for (const id of new Set(r.rows.map((x) => x.pipeline))) {
+    for (const ms of r.intervalsMs) {
+      const runs = r.rows.filter((x) => x.ok && x.pipeline === id && x.batchingMs === ms);
+      const d = pairDifferences(runs, (x) => x.v8Tiering !== false, false, true);
+      if (d.length === 0) continue;
+      lines.push(
+        `- ${id}, batching ${ms} ms: the engine's tier-up thresholds save ` +
+          `${d.map((x) => fmt(x, 2)).join(", ")} % of one core against V8's own in ${d.length} ` +
+          `pair(s) of runs (mean ${fmt(mean(d), 2)} %, median ${fmt(quantile(d, 0.5), 2)} %)`,
+      );
+    }
+  }
+  return lines.length ? [...lines, ""] : [];
 }
 
 /**
@@ -115,7 +147,7 @@ function telemetryCost(r: BatchingResult): string[] {
   for (const id of new Set(r.rows.map((x) => x.pipeline))) {
     for (const ms of r.intervalsMs) {
       const runs = r.rows.filter((x) => x.ok && x.pipeline === id && x.batchingMs === ms);
-      const d = pairDifferences(runs, hi, lo);
+      const d = pairDifferences(runs, (x) => x.telemetryHz, hi, lo);
       if (d.length === 0) continue;
       lines.push(
         `- ${id}, batching ${ms} ms: telemetry at ${hi} Hz instead of ${lo} Hz costs ` +
@@ -140,15 +172,20 @@ function telemetryCost(r: BatchingResult): string[] {
 }
 
 /**
- * CPU at `hi` minus CPU at `lo` in each pair of consecutive runs (runs 1–2, 3–4, …) that holds one
- * run at each rate, in either order.
+ * CPU where `key` is `hi` minus CPU where it is `lo`, in each pair of consecutive runs (runs 1–2,
+ * 3–4, …) that holds one run of each, in either order.
  */
-function pairDifferences(runs: BatchingRow[], hi: number, lo: number): number[] {
+function pairDifferences<K>(
+  runs: BatchingRow[],
+  key: (x: BatchingRow) => K,
+  hi: K,
+  lo: K,
+): number[] {
   const d: number[] = [];
   for (let i = 0; i + 1 < runs.length; i += 2) {
     const [a, b] = [runs[i]!, runs[i + 1]!];
-    if (a.telemetryHz === hi && b.telemetryHz === lo) d.push(a.cpuMedianPct - b.cpuMedianPct);
-    else if (a.telemetryHz === lo && b.telemetryHz === hi) d.push(b.cpuMedianPct - a.cpuMedianPct);
+    if (key(a) === hi && key(b) === lo) d.push(a.cpuMedianPct - b.cpuMedianPct);
+    else if (key(a) === lo && key(b) === hi) d.push(b.cpuMedianPct - a.cpuMedianPct);
   }
   return d;
 }
@@ -157,7 +194,7 @@ function batchingRow(x: BatchingRow): string[] {
   if (!x.ok) {
     const dashes = ["-", "-", "-", "-", "-"];
     return [
-      x.pipeline,
+      sweepRunName(x),
       String(x.batchingMs),
       String(x.telemetryHz ?? 20),
       `failed: ${x.error ?? "?"}`,
@@ -166,7 +203,7 @@ function batchingRow(x: BatchingRow): string[] {
     ];
   }
   return [
-    x.pipeline,
+    sweepRunName(x),
     String(x.batchingMs),
     String(x.telemetryHz ?? 20),
     fmt(x.cpuMedianPct, 2),
@@ -179,6 +216,11 @@ function batchingRow(x: BatchingRow): string[] {
     x.samplesLost === null ? "-" : String(x.samplesLost),
     load(x.loadAvgBefore),
   ];
+}
+
+/** A sweep row's pipeline, and "(V8's own tiering)" for a run that kept V8's thresholds. */
+function sweepRunName(x: BatchingRow): string {
+  return x.v8Tiering === false ? `${x.pipeline} (V8's own tiering)` : x.pipeline;
 }
 
 /** The replays' throughput, one row per recording. */

@@ -216,6 +216,8 @@ export interface BatchingRow {
   /** Telemetry per second of the run (`--telemetry-hz`); absent in results written before the
    * telemetry sweep, whose runs all had the CLI's default, 20. */
   telemetryHz?: number;
+  /** false: the run kept V8's own tier-up thresholds (the tiering sweep); absent: the engine's. */
+  v8Tiering?: boolean;
   ok: boolean;
   error?: string;
   cpuMedianPct: number;
@@ -239,6 +241,8 @@ export interface BatchingResult {
   intervalsMs: number[];
   /** The telemetry rates swept at each interval (the telemetry sweep only). */
   telemetryHz?: number[];
+  /** The tier-up thresholds swept at each interval (the tiering sweep only; see BatchingRow). */
+  v8Tiering?: boolean[];
   rows: BatchingRow[];
   loadAvgBefore: number[];
   loadAvgAfter: number[];

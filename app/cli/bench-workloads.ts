@@ -38,6 +38,11 @@ export interface BatchingDef {
    * difference is the cost of telemetry; left out: the CLI's default (20 Hz, as the UI) only.
    */
   telemetryHz?: number[];
+  /**
+   * Runs with the engine's V8 tier-up thresholds (true) and V8's own (false), one after the other
+   * at each interval (the tiering sweep, app/host/tiering.ts); left out: the engine's only.
+   */
+  v8Tiering?: boolean[];
 }
 export interface ReplayDef {
   kind: "replay";
@@ -224,6 +229,16 @@ export const WORKLOADS: WorkloadDef[] = [
     intervalsMs: [5], // the default (DEFAULT_BATCHING_S, app/engine/runtime/runtime.ts)
     // Pairs in alternating order (20 then 2, 2 then 20, …): a steady drift of the load cancels.
     telemetryHz: [20, 2, 2, 20, 20, 2, 2, 20],
+  },
+  {
+    kind: "batching",
+    id: "tiering",
+    title:
+      "V8 tiering — the Myo pipeline at the default batching interval with the engine's V8 tier-up thresholds and with V8's own, in turn: CPU",
+    pipelines: ["myo"],
+    intervalsMs: [5],
+    // Pairs in alternating order, as the telemetry sweep's.
+    v8Tiering: [false, true, true, false, false, true, true, false],
   },
   {
     kind: "soak",

@@ -17,6 +17,13 @@ describe("V8 tiering for the engine", () => {
     expect(setFlagsFromString.mock.calls).toEqual(TIERING_FLAGS.map((f) => [f]));
   });
 
+  it("keeps V8's own thresholds when MOSAIC_V8_TIERING=v8", async () => {
+    const { tuneTiering, TIERING_ENV } = await import("./tiering");
+    tuneTiering({ [TIERING_ENV]: "v8" });
+    tuneTiering();
+    expect(setFlagsFromString).not.toHaveBeenCalled();
+  });
+
   it("lowers V8's thresholds rather than raising them", async () => {
     const { TIERING_FLAGS } = await import("./tiering");
     const defaults = execFileSync(process.execPath, ["--v8-options"], { encoding: "utf8" });

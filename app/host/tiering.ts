@@ -15,7 +15,8 @@
  *
  * The flags are process-wide and must be set before the engine's workers compile their code: the
  * Node host and the session hub call `tuneTiering` before they start a worker. Browsers do not let
- * a page set them (the web build runs with the browser's own thresholds).
+ * a page set them (the web build runs with the browser's own thresholds). `MOSAIC_V8_TIERING=v8`
+ * in the environment keeps V8's own thresholds (the bench's tiering sweep compares the two).
  */
 import { setFlagsFromString } from "node:v8";
 
@@ -26,11 +27,18 @@ export const TIERING_FLAGS = [
   "--wasm-tiering-budget=100000",
 ] as const;
 
+/** The environment variable that, set to "v8", keeps V8's own thresholds. */
+export const TIERING_ENV = "MOSAIC_V8_TIERING";
+
 let tuned = false;
 
-/** Lowers V8's tier-up thresholds for this process (once; later calls do nothing). */
-export function tuneTiering(): void {
+/**
+ * Lowers V8's tier-up thresholds for this process (once; later calls do nothing), unless the
+ * environment asks for V8's own (`TIERING_ENV`).
+ */
+export function tuneTiering(env: NodeJS.ProcessEnv = process.env): void {
   if (tuned) return;
   tuned = true;
+  if (env[TIERING_ENV] === "v8") return;
   for (const flag of TIERING_FLAGS) setFlagsFromString(flag);
 }
