@@ -4,6 +4,7 @@ import { pipelineMarkdown, udpRxLine } from "./bench-report-pipeline";
 import { targets } from "./bench-targets";
 import type {
   BatchingResult,
+  BatchingRow,
   BlockRow,
   LearnResult,
   PipelineResult,
@@ -93,6 +94,23 @@ const rx: UdpRxFigures = {
   datagramsAll: 2700,
   malformed: 0,
 };
+
+/** A Myo run of a sweep at 5 ms, with `over` for what the test varies. */
+function myoSweepRun(over: Partial<BatchingRow>): BatchingRow {
+  return {
+    pipeline: "myo",
+    batchingMs: 5,
+    ok: true,
+    cpuMedianPct: NaN,
+    engineWakeupsPerS: 100,
+    sender: null,
+    acquisition: null,
+    udpRateHz: 25,
+    samplesLost: 0,
+    loadAvgBefore: [0.5, 0.4, 0.3],
+    ...over,
+  };
+}
 
 describe("bench report", () => {
   test("the Myo pipeline's tables follow the paper's row order, extra blocks last", () => {
@@ -216,19 +234,7 @@ describe("bench report", () => {
   });
 
   test("the telemetry sweep: runs in turn at each rate, the cost is the median of the pairs' differences", () => {
-    const row = (hz: number, cpu: number): BatchingResult["rows"][number] => ({
-      pipeline: "myo",
-      batchingMs: 5,
-      telemetryHz: hz,
-      ok: true,
-      cpuMedianPct: cpu,
-      engineWakeupsPerS: 100,
-      sender: null,
-      acquisition: null,
-      udpRateHz: 25,
-      samplesLost: 0,
-      loadAvgBefore: [0.5, 0.4, 0.3],
-    });
+    const row = (hz: number, cpu: number) => myoSweepRun({ telemetryHz: hz, cpuMedianPct: cpu });
     const r: BatchingResult = {
       kind: "batching",
       id: "telemetry",
@@ -265,20 +271,8 @@ describe("bench report", () => {
   });
 
   test("the tiering sweep: runs in turn with V8's thresholds and the engine's, the saving per pair", () => {
-    const row = (engine: boolean, cpu: number): BatchingResult["rows"][number] => ({
-      pipeline: "myo",
-      batchingMs: 5,
-      telemetryHz: 20,
-      v8Tiering: engine,
-      ok: true,
-      cpuMedianPct: cpu,
-      engineWakeupsPerS: 100,
-      sender: null,
-      acquisition: null,
-      udpRateHz: 25,
-      samplesLost: 0,
-      loadAvgBefore: [0.5, 0.4, 0.3],
-    });
+    const row = (engine: boolean, cpu: number) =>
+      myoSweepRun({ telemetryHz: 20, v8Tiering: engine, cpuMedianPct: cpu });
     const order = [false, true, true, false];
     const r: BatchingResult = {
       kind: "batching",
