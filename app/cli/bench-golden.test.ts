@@ -76,6 +76,8 @@ function everything(d: BenchDocument): BenchDocument {
     title: "(b) Delsys pipeline — 32 ch @ 1926 Hz",
     wakeFloorHz: 481.5,
     wakeFloorPct: 0.812,
+    ioFloorPct: 1.204,
+    ioFloorDatagramsPerS: 75.1,
     warnings: ["warning: Sender: port busy", "error: Control: out of range"],
     killedAfterSummary: true,
   };

@@ -11,7 +11,7 @@ import type { BlockTelemetry, Telemetry } from "../engine/runtime/runtime";
 import { runChild, type ChildRun, type CpuSample, type Summary } from "./bench-proc";
 import { clkTck } from "./bench-procfs";
 import { BenchReceiver } from "./bench-receiver";
-import { measureWakeFloor, startNeighbour, wakeRate } from "./bench-side-procs";
+import { measureIoFloor, measureWakeFloor, startNeighbour, wakeRate } from "./bench-side-procs";
 import { mean, quantile, std } from "./bench-stats";
 import type { BlockRow, CpuFigures, PipelineResult, TimerFigures } from "./bench-types";
 import { loadAvg, progress, round, sleep } from "./bench-util";
@@ -70,7 +70,9 @@ export async function runPipeline(
 
 /**
  * After a pipeline workload (not the loaded run, not the sweep): the CPU of a bare worker waking
- * at the pipeline's wake-up rate, the floor the pipeline cannot go below on this machine.
+ * at the pipeline's wake-up rate, the floor the pipeline cannot go below on this machine, and of
+ * the same worker sending the datagrams the pipeline sent (per event, at its event rate) to a
+ * receiver in this process: the floor with its output.
  */
 export async function addWakeFloor(
   def: PipelineDef,
@@ -80,13 +82,23 @@ export async function addWakeFloor(
   const rate = def.wakeHz ?? r.timers[0]?.desiredRate;
   if (!o.useNs || rate === undefined || !(rate > 0) || def.neighbour) return;
   const hz = def.wakeHz ?? wakeRate(rate, r.batchingMs);
+  const seconds = o.quick ? 3 : 10;
   progress(
     def.wakeHz !== undefined
       ? `${def.id}: wake-up floor, a bare worker sleeping at ${hz.toFixed(1)} Hz (the device's packets)`
       : `${def.id}: wake-up floor, a bare worker sleeping at ${hz.toFixed(1)} Hz (${rate} Hz ticks, batching ${r.batchingMs} ms)`,
   );
   r.wakeFloorHz = round(hz, 2);
-  r.wakeFloorPct = round(await measureWakeFloor(hz, o.quick ? 3 : 10));
+  r.wakeFloorPct = round(await measureWakeFloor(hz, seconds));
+  const eventHz = def.udpRateHz;
+  const perEvent = r.udp?.perEvent;
+  if (eventHz === undefined || perEvent === undefined || !(r.udp!.datagrams > 0)) return;
+  progress(
+    `${def.id}: wake-up floor with the pipeline's datagrams, ${perEvent} per event at ${eventHz.toFixed(2)} Hz`,
+  );
+  const io = await measureIoFloor(hz, { eventHz, perEvent }, seconds);
+  r.ioFloorPct = round(io.pct);
+  r.ioFloorDatagramsPerS = round(io.udp.datagramsPerSecond, 1);
 }
 
 function runArgs(def: PipelineDef, o: PipelineRunOptions, file: string, total: number): string[] {

@@ -99,6 +99,15 @@ function cpuLines(r: PipelineResult, c: CpuFigures): string[] {
         `${fmtPct(r.wakeFloorPct)} of one core on this machine`,
     );
   }
+  if (r.ioFloorPct !== undefined) {
+    lines.push(
+      `Wake-up floor with the pipeline's output: the same worker, also sending the pipeline's ` +
+        `datagrams from a connected socket to a receiver in another process ` +
+        `(${fmt(r.ioFloorDatagramsPerS, 1)} datagrams/s arrived) and turning its event loop every ` +
+        `50 ms, uses ${fmtPct(r.ioFloorPct)} of one core: what waking this often and sending ` +
+        `this much costs here before anything is computed`,
+    );
+  }
   if (c.threads.length) {
     lines.push(
       `CPU by thread (steady-state mean; wake-ups = voluntary context switches per second): ` +

@@ -1,12 +1,16 @@
 /**
  * `mosaic bench`: the processes it runs beside the workloads — a bare worker that shows what
- * waking up alone costs on this machine (the wake-up floor), and the neighbour that burns a core
- * during the loaded run.
+ * waking up alone costs on this machine (the wake-up floor), the same worker sending a pipeline's
+ * datagrams (the floor with its output), and the neighbour that burns a core during the loaded run.
  */
-import { spawn } from "node:child_process";
+import { spawn, type ChildProcess } from "node:child_process";
+import { BenchReceiver, type UdpRxFigures } from "./bench-receiver";
 import { clkTck, nsDelta, readStatTicks, readTaskNs } from "./bench-procfs";
 import { quantile } from "./bench-stats";
 import { sleep } from "./bench-util";
+
+/** How long a floor worker runs before its CPU is sampled (start-up, connecting), ms. */
+const SETTLE_MS = 1500;
 
 /**
  * How often a worker wakes for a timer of `hz` ticks per second with a batching interval of
@@ -29,15 +33,94 @@ export async function measureWakeFloor(hz: number, seconds: number): Promise<num
     "const b=new Int32Array(new SharedArrayBuffer(4));const p=1000/" +
     String(hz) +
     ";const s=performance.now();let k=1;for(;;){const r=s+k*p-performance.now();if(r>0)Atomics.wait(b,0,0,r);k++;}";
-  const child = spawn(
+  return medianCpu(spawnWorker(worker), seconds);
+}
+
+/** What a pipeline sends: events per second, datagrams per event, and where the bench receives. */
+export interface FloorDatagrams {
+  eventHz: number;
+  perEvent: number;
+  port: number;
+}
+
+/**
+ * The wake-up floor with the pipeline's output: the bare worker of `measureWakeFloor`, waking at
+ * `hz`, also sends `perEvent` streamlined datagrams (count 1, f64) per event at `eventHz` from a
+ * connected node:dgram socket with a completion callback, to a receiver in another process
+ * (127.0.0.1:`port`), and turns its event loop every 50 ms, as an engine worker does. What any
+ * program that wakes this often and sends this much costs here, before it computes anything.
+ * The worker's source is a literal (not a bundled function) because it runs as an eval'd worker.
+ */
+export function ioFloorWorker(hz: number, d: FloorDatagrams): string {
+  return `
+const dgram = require("node:dgram");
+const bell = new Int32Array(new SharedArrayBuffer(4));
+const wakeMs = 1000 / ${hz}, eventMs = 1000 / ${d.eventHz}, perEvent = ${d.perEvent};
+const socket = dgram.createSocket("udp4");
+const buf = Buffer.alloc(22);
+const view = new DataView(buf.buffer, buf.byteOffset, buf.length);
+let counter = 0;
+const afterSend = (err) => { if (err) process.exitCode = 1; };
+function sendEvent(t) {
+  for (let k = 0; k < perEvent; k++) {
+    buf[0] = 1; buf[1] = 0x28; buf[2] = 1; buf[3] = k;
+    view.setFloat64(4, t, true); view.setFloat64(12, k, true); view.setUint16(20, counter, true);
+    counter = (counter + 1) & 0xffff;
+    socket.send(buf, afterSend);
+  }
+}
+socket.connect(${d.port}, "127.0.0.1", () => {
+  const start = performance.now();
+  let wake = 1, event = 1;
+  const turn = () => {
+    const until = performance.now() + 50;
+    while (performance.now() < until) {
+      const r = start + wake * wakeMs - performance.now();
+      if (r > 0) Atomics.wait(bell, 0, 0, r);
+      wake++;
+      while (start + event * eventMs <= performance.now()) sendEvent(event++ * eventMs / 1000);
+    }
+    setImmediate(turn);
+  };
+  turn();
+});`;
+}
+
+/**
+ * The floor with the pipeline's datagrams (`ioFloorWorker`), % of one core (median of 1-s samples
+ * over `seconds`), and what reached the receiver over those seconds (the receiver's figures), so a
+ * report shows that they were sent.
+ */
+export async function measureIoFloor(
+  hz: number,
+  d: Omit<FloorDatagrams, "port">,
+  seconds: number,
+): Promise<{ pct: number; udp: UdpRxFigures }> {
+  const rx = await BenchReceiver.open(0);
+  try {
+    const from = performance.now() + SETTLE_MS;
+    const pct = await medianCpu(spawnWorker(ioFloorWorker(hz, { ...d, port: rx.port })), seconds);
+    return { pct, udp: rx.figures(from, performance.now(), d.eventHz) };
+  } finally {
+    await rx.close();
+  }
+}
+
+/** A child process running `source` in one worker thread (its main thread only waits). */
+function spawnWorker(source: string): ChildProcess {
+  return spawn(
     process.execPath,
-    ["-e", `new (require("node:worker_threads").Worker)(${JSON.stringify(worker)},{eval:true})`],
+    ["-e", `new (require("node:worker_threads").Worker)(${JSON.stringify(source)},{eval:true})`],
     { stdio: "ignore" },
   );
+}
+
+/** The child's CPU, % of one core: the median of 1-s samples over `seconds` after 1.5 s; kills it. */
+async function medianCpu(child: ChildProcess, seconds: number): Promise<number> {
   const pid = child.pid;
   try {
     if (pid === undefined) return NaN;
-    await sleep(1500);
+    await sleep(SETTLE_MS);
     const samples: number[] = [];
     let prev = readTaskNs(pid);
     for (let i = 0; i < seconds; i++) {

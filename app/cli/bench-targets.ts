@@ -180,6 +180,9 @@ function cpuNote(r: PipelineResult, c: CpuFigures): string {
   return (
     spread +
     `; wake-up floor on this machine (a bare worker waking at the pipeline's ${fmt(r.wakeFloorHz, 1)} Hz, nothing else): ${fmtPct(r.wakeFloorPct)}` +
+    (r.ioFloorPct !== undefined
+      ? `, ${fmtPct(r.ioFloorPct)} when it also sends the pipeline's ${fmt(r.ioFloorDatagramsPerS, 1)} datagrams/s`
+      : "") +
     `; engine thread ${fmt(c.engineWakeupsPerS, 0)} wake-ups/s, batching interval ${fmt(r.batchingMs, 1)} ms`
   );
 }

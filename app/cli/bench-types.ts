@@ -91,6 +91,11 @@ export interface PipelineResult {
    * timer rate batched by batchingMs), % of one core, and that rate (Hz). */
   wakeFloorPct?: number;
   wakeFloorHz?: number;
+  /** CPU of that worker when it also sends the pipeline's datagrams (as many per event, at the
+   * pipeline's event rate) to a receiver in another process, % of one core, and the datagrams per
+   * second that arrived meanwhile. */
+  ioFloorPct?: number;
+  ioFloorDatagramsPerS?: number;
   /** The batching interval of the pipeline's first ScheduledTimer, ms (from its telemetry). */
   batchingMs: number;
   /** The acquisition block (the simulated device), e.g. Delsys. */
