@@ -78,6 +78,13 @@ function everything(d: BenchDocument): BenchDocument {
     wakeFloorPct: 0.812,
     ioFloorPct: 1.204,
     ioFloorDatagramsPerS: 75.1,
+    recording: {
+      file: "bench/results/delsys.xdf.tmp",
+      bytes: 12_582_912,
+      mibPerS: 1.9,
+      expectedMiBPerS: 2,
+      magic: false,
+    },
     warnings: ["warning: Sender: port busy", "error: Control: out of range"],
     killedAfterSummary: true,
   };

@@ -4,8 +4,8 @@
  * burning a core; its CPU, memory, Table 5/6 rows, timers, samples lost and UDP figures, and the
  * wake-up floor at its wake-up rate.
  */
-import { readFileSync } from "node:fs";
-import { join, relative } from "node:path";
+import { closeSync, openSync, readFileSync, readSync, rmSync, statSync } from "node:fs";
+import { dirname, join, relative, resolve } from "node:path";
 import { TrignoSimulator } from "../devices/trigno-simulator";
 import type { BlockTelemetry, Telemetry } from "../engine/runtime/runtime";
 import { runChild, type ChildRun, type CpuSample, type Summary } from "./bench-proc";
@@ -47,6 +47,12 @@ export async function runPipeline(
     `${def.id}: ${def.title}${o.batchingMs !== undefined ? `, --batching-ms ${o.batchingMs}` : ""} (${total} s)`,
   );
   const res = notRun(def, o, file, args, before);
+  const recording = def.recording ? recordingFile(path) : undefined;
+  if (def.recording && !recording) {
+    res.error = `${file} records, but no File: param was found in it`;
+    return res;
+  }
+  if (recording) rmSync(recording, { force: true });
   // The device end: bind the Sender's port before the pipeline starts sending.
   let rx: BenchReceiver | undefined;
   try {
@@ -65,7 +71,60 @@ export async function runPipeline(
     if (Number.isFinite(w.from)) res.udp = rx.figures(w.from, w.to, def.udpRateHz);
   }
   checkRun(res, run, o.warmup);
+  if (recording) checkRecording(res, recording, def.recording!.mibPerS, total, o.root);
   return res;
+}
+
+/** The file a recording pipeline writes (its `File:` param, relative to the pipeline's folder). */
+function recordingFile(pipeline: string): string | undefined {
+  const m = /^\s+File:\s*(\S+)/m.exec(readFileSync(pipeline, "utf8"));
+  return m ? resolve(dirname(pipeline), m[1]!) : undefined;
+}
+
+/**
+ * After a recording pipeline's run: the file must exist, start with the XDF magic and hold at
+ * least half of what `mibPerS` over the run's `seconds` makes (start-up and the warm-up's first
+ * moments are in the run, not in the file); it is deleted either way (117 MiB a run).
+ */
+function checkRecording(
+  res: PipelineResult,
+  file: string,
+  mibPerS: number,
+  seconds: number,
+  root: string,
+): void {
+  let bytes = 0;
+  let magic = false;
+  try {
+    bytes = statSync(file).size;
+    const head = Buffer.alloc(4);
+    const fd = openSync(file, "r");
+    try {
+      readSync(fd, head, 0, 4, 0);
+    } finally {
+      closeSync(fd);
+    }
+    magic = head.toString("latin1") === "XDF:";
+  } catch {
+    // missing: reported below
+  } finally {
+    rmSync(file, { force: true });
+  }
+  const rate = bytes / 2 ** 20 / seconds;
+  res.recording = {
+    file: relative(root, file),
+    bytes,
+    mibPerS: round(rate, 3),
+    expectedMiBPerS: round(mibPerS, 3),
+    magic,
+  };
+  if (!res.ok) return;
+  if (!magic || rate < mibPerS / 2) {
+    res.ok = false;
+    res.error = bytes
+      ? `the recording ${res.recording.file} is not what the pipeline should write: ${magic ? "" : "no XDF magic, "}${rate.toFixed(2)} MiB/s over the run (${mibPerS.toFixed(2)} expected)`
+      : `the recording ${res.recording.file} was not written`;
+  }
 }
 
 /**

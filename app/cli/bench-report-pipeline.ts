@@ -99,6 +99,15 @@ function cpuLines(r: PipelineResult, c: CpuFigures): string[] {
         `${fmtPct(r.wakeFloorPct)} of one core on this machine`,
     );
   }
+  const rec = r.recording;
+  if (rec) {
+    lines.push(
+      `Recording: \`${rec.file}\` ${(rec.bytes / 2 ** 20).toFixed(1)} MiB, ${fmt(rec.mibPerS, 2)} MiB/s ` +
+        `over the run (the raw grid makes ${fmt(rec.expectedMiBPerS, 2)} MiB/s; start-up is in the ` +
+        `run, not in the file), ${rec.magic ? "starts with the XDF magic" : "**no XDF magic**"}; ` +
+        `deleted after this check`,
+    );
+  }
   if (r.ioFloorPct !== undefined) {
     lines.push(
       `Wake-up floor with the pipeline's output: the same worker, also sending the pipeline's ` +

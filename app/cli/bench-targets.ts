@@ -163,7 +163,11 @@ function recordingCostRow(results: WorkloadResult[]): TargetRow {
     a && b
       ? {
           value: a.medianPct - b.medianPct,
-          note: `hdemg-xdf ${fmtPct(a.medianPct)}, hdemg ${fmtPct(b.medianPct)} (medians of 1-s samples, one run each)`,
+          note:
+            `hdemg-xdf ${fmtPct(a.medianPct)}, hdemg ${fmtPct(b.medianPct)} (medians of 1-s samples, one run each)` +
+            (withRec!.recording
+              ? `; the recording: ${fmt(withRec!.recording.mibPerS, 2)} MiB/s over the run, XDF magic checked`
+              : ""),
         }
       : null,
     fmtPct,

@@ -96,6 +96,8 @@ export interface PipelineResult {
    * second that arrived meanwhile. */
   ioFloorPct?: number;
   ioFloorDatagramsPerS?: number;
+  /** What the pipeline recorded (workloads with `recording`), checked and then deleted. */
+  recording?: RecordingFigures;
   /** The batching interval of the pipeline's first ScheduledTimer, ms (from its telemetry). */
   batchingMs: number;
   /** The acquisition block (the simulated device), e.g. Delsys. */
@@ -342,4 +344,16 @@ export interface TargetRow {
   display: string;
   pass: boolean | null;
   note: string;
+}
+
+/** A bench pipeline's recording, read back after its run. */
+export interface RecordingFigures {
+  /** Relative to the repository. */
+  file: string;
+  bytes: number;
+  /** Bytes over the run's length (start-up included), MiB/s, and what the workload expects. */
+  mibPerS: number;
+  expectedMiBPerS: number;
+  /** The file starts with the XDF magic `XDF:`. */
+  magic: boolean;
 }

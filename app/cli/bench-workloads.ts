@@ -25,6 +25,12 @@ export interface PipelineDef {
   simulator?: { device: "delsys"; commandPort: number; emgPort: number; auxPort: number };
   /** The engine's wake-ups per second when the device's packets pace it (the wake-up floor's rate). */
   wakeHz?: number;
+  /**
+   * The pipeline records to the file its `File:` param names (relative to the pipeline): the bench
+   * removes it before the run, checks afterwards that it was written (XDF magic, size against
+   * `mibPerS` over the run) and deletes it.
+   */
+  recording?: { mibPerS: number };
 }
 export interface BatchingDef {
   kind: "batching";
@@ -147,6 +153,7 @@ export const WORKLOADS: WorkloadDef[] = [
     file: "hdemg-xdf.yaml",
     acquisition: "HDEMG",
     udpRateHz: HDEMG_25,
+    recording: { mibPerS: (256 * 4 * 2048) / 2 ** 20 },
   },
   {
     kind: "pipeline",
