@@ -60,7 +60,9 @@ const socket = dgram.createSocket("udp4");
 const buf = Buffer.alloc(22);
 const view = new DataView(buf.buffer, buf.byteOffset, buf.length);
 let counter = 0;
-const afterSend = (err) => { if (err) process.exitCode = 1; };
+// A completion callback as the product's bridge has (its cost is part of the floor); a datagram
+// lost shows at the receiver as a counter gap.
+const afterSend = () => {};
 function sendEvent(t) {
   for (let k = 0; k < perEvent; k++) {
     buf[0] = 1; buf[1] = 0x28; buf[2] = 1; buf[3] = k;
