@@ -45,13 +45,14 @@ export interface FloorDatagrams {
 
 /**
  * The wake-up floor with the pipeline's output: the bare worker of `measureWakeFloor`, waking at
- * `hz`, also sends `perEvent` streamlined datagrams (count 1, f64) per event at `eventHz` from a
+ * `hz`, also sends `perEvent` streamlined datagrams (count 1, f64: 22 bytes, what the
+ * ControlAlgorithm → UdpSender of every bench pipeline sends) per event at `eventHz` from a
  * connected node:dgram socket with a completion callback, to a receiver in another process
  * (127.0.0.1:`port`), and turns its event loop every 50 ms, as an engine worker does. What any
  * program that wakes this often and sends this much costs here, before it computes anything.
  * The worker's source is a literal (not a bundled function) because it runs as an eval'd worker.
  */
-export function ioFloorWorker(hz: number, d: FloorDatagrams): string {
+function ioFloorWorker(hz: number, d: FloorDatagrams): string {
   return `
 const dgram = require("node:dgram");
 const bell = new Int32Array(new SharedArrayBuffer(4));
