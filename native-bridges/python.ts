@@ -395,201 +395,341 @@ const formatS = (ms: number): string => `${ms % 1000 === 0 ? ms / 1000 : (ms / 1
 
 export function createPythonBridge(options: PythonBridgeOptions = {}): PythonBridge {
   const root = options.root ?? repoRoot();
-  const command = options.command ?? defaultCommand(root);
-  const backoff = options.backoffMs ?? { first: 500, max: 10_000 };
-  const loadTimeoutMs = options.loadTimeoutMs ?? 120_000;
-  const nice = options.nice ?? SIDECAR_NICE;
-  return {
-    load: (o) => startSidecar(o, command, backoff, loadTimeoutMs, nice),
+  const settings: SidecarSettings = {
+    command: options.command ?? defaultCommand(root),
+    backoff: options.backoffMs ?? { first: 500, max: 10_000 },
+    loadTimeoutMs: options.loadTimeoutMs ?? 120_000,
+    nice: options.nice ?? SIDECAR_NICE,
   };
+  return { load: (o) => Sidecar.start(o, settings) };
 }
 
-async function startSidecar(
-  o: PythonLoadOptions,
-  command: (cwd: string) => SidecarCommand | Promise<SidecarCommand>,
-  backoff: { first: number; max: number },
-  loadTimeoutMs: number,
-  nice: number,
-): Promise<PythonSidecar> {
-  const cwd = o.cwd ?? process.cwd();
-  let nextId = 1;
-  const id = (): number => {
-    const i = nextId;
-    nextId = nextId >= 0xfffffff0 ? 1 : nextId + 1;
-    return i;
-  };
-  let proc: Proc | undefined;
-  let ready = false;
-  let closed = false;
-  let version = "";
-  let outputShape = { rows: 1, cols: 1 };
-  let outSize = 1;
-  let out = new Float64Array(1);
+/** How the bridge starts and restarts sidecars (`PythonBridgeOptions` with their defaults). */
+interface SidecarSettings {
+  command: (cwd: string) => SidecarCommand | Promise<SidecarCommand>;
+  backoff: { first: number; max: number };
+  loadTimeoutMs: number;
+  nice: number;
+}
+
+/**
+ * One Python block's sidecar: its current process, the calls in flight, the watchdog for slow
+ * and hung calls, and restarts with backoff after the process dies.
+ */
+class Sidecar implements PythonSidecar {
+  private readonly cwd: string;
+  private nextId = 1;
+  private proc: Proc | undefined;
+  /** A process is loaded and accepting calls. */
+  private loaded = false;
+  private closed = false;
+  private versionText = "";
+  private shape = { rows: 1, cols: 1 };
+  private out = new Float64Array(1);
   /** Calls sent to the current process and not answered yet, oldest first. */
-  const inFlight: number[] = [];
+  private readonly inFlight: number[] = [];
   /** Since when the oldest call in flight is the one the process works on (ms). */
-  let headSince = 0;
-  let delay = backoff.first;
-  let readySince = 0;
-  let retry: ReturnType<typeof setTimeout> | undefined;
-  const hardLimitMs = o.hardLimitMs !== undefined && o.hardLimitMs > 0 ? o.hardLimitMs : Infinity;
+  private headSince = 0;
+  private delay: number;
+  private readySince = 0;
+  private retry: ReturnType<typeof setTimeout> | undefined;
+  private readonly hardLimitMs: number;
+  private readonly lateAfterMs: number;
   /** The call that passed the hard limit (its process is being killed). */
-  let timedOut = -1;
+  private timedOut = -1;
   /**
    * One entry per `reset` not answered yet: how many calls in flight are still ahead of it.
    * `init` may take long (training); the calls behind it wait and their time does not run.
    */
-  const resets: number[] = [];
-  let watchdog: ReturnType<typeof setInterval> | undefined;
+  private readonly resets: number[] = [];
+  private watchdog: ReturnType<typeof setInterval> | undefined;
 
-  const onCall = (type: number, callId: number, payload: Buffer): void => {
-    const k = inFlight.indexOf(callId);
-    if (k >= 0) {
-      inFlight.splice(k, 1);
-      if (k === 0) headSince = performance.now();
-      for (let i = 0; i < resets.length; i++) if (resets[i]! > 0) resets[i]!--;
-    }
-    if (closed) return;
-    if (type === MSG.result) {
-      const us = payload.length >= 8 ? payload.readDoubleLE(0) : NaN;
-      const n = decodeArrayInto(payload, 8, out);
-      if (typeof n === "string") {
-        o.onError(callId, {
-          message: `bad result from the sidecar: ${n}`,
-          traceback: "",
-          kind: "protocol",
-        });
-      } else {
-        o.onResult(callId, out, us);
-      }
-    } else if (type === MSG.error) {
-      const e = parseJson(payload);
-      const err: PythonCallError = {
-        message: String(e.message ?? "error"),
-        traceback: String(e.traceback ?? ""),
-        kind: String(e.kind ?? "call"),
-      };
-      if (err.kind === "init" && callId === 0) o.onError(0, err);
-      else o.onError(callId, err);
-    }
-  };
+  /** Starts the first process and loads the module; rejects with a PythonLoadError. */
+  static async start(o: PythonLoadOptions, settings: SidecarSettings): Promise<PythonSidecar> {
+    const sidecar = new Sidecar(o, settings);
+    await sidecar.launch();
+    sidecar.markReady();
+    sidecar.startWatchdog();
+    o.onStatus("ready");
+    return sidecar;
+  }
 
-  const lateAfterMs =
-    o.onLate && o.lateAfterMs !== undefined && o.lateAfterMs >= 0 ? o.lateAfterMs : Infinity;
+  private constructor(
+    private readonly o: PythonLoadOptions,
+    private readonly settings: SidecarSettings,
+  ) {
+    this.cwd = o.cwd ?? process.cwd();
+    this.delay = settings.backoff.first;
+    this.hardLimitMs = o.hardLimitMs !== undefined && o.hardLimitMs > 0 ? o.hardLimitMs : Infinity;
+    this.lateAfterMs =
+      o.onLate && o.lateAfterMs !== undefined && o.lateAfterMs >= 0 ? o.lateAfterMs : Infinity;
+  }
 
-  /**
-   * The oldest call in flight: reported while it runs past `lateAfterMs`; past the hard limit
-   * the process is killed (and restarted by `crashed`).
-   */
-  const watchCalls = (): void => {
-    const p = proc;
-    if (!p || !ready || closed || inFlight.length === 0 || p.cause) return;
-    if (resets.length > 0 && resets[0] === 0) return; // the oldest call waits behind a reset
-    const running = performance.now() - headSince;
-    if (running > lateAfterMs) o.onLate?.(inFlight[0]!, running);
-    if (running <= hardLimitMs || closed || proc !== p) return;
-    timedOut = inFlight[0]!;
-    p.cause = `a call ran longer than its hard limit of ${formatS(hardLimitMs)} (HardLimit)`;
-    p.kill();
-  };
+  get outputShape(): { rows: number; cols: number } {
+    return this.shape;
+  }
+
+  get pid(): number | undefined {
+    return this.proc?.pid;
+  }
+
+  get version(): string {
+    return this.versionText;
+  }
+
+  get ready(): boolean {
+    return this.loaded && !this.closed;
+  }
+
+  call(values: Float64Array): number {
+    const p = this.proc;
+    if (!this.loaded || this.closed || !p) return -1;
+    const callId = this.newId();
+    if (this.inFlight.length === 0) this.headSince = performance.now();
+    this.inFlight.push(callId);
+    p.write(encodeCall(callId, values, this.o.inputShape.rows, this.o.inputShape.cols));
+    return callId;
+  }
+
+  reset(): void {
+    const p = this.proc;
+    if (!this.loaded || this.closed || !p) return;
+    this.resets.push(this.inFlight.length);
+    void p.request(MSG.reset, this.newId()).then(({ type, payload }) => {
+      this.resetAnswered(p, type, payload);
+    });
+  }
+
+  close(): void {
+    if (this.closed) return;
+    this.closed = true;
+    this.loaded = false;
+    if (this.retry) clearTimeout(this.retry);
+    this.retry = undefined;
+    if (this.watchdog) clearInterval(this.watchdog);
+    this.watchdog = undefined;
+    const p = this.proc;
+    this.proc = undefined;
+    p?.stop();
+    this.o.onStatus("closed");
+  }
+
+  private newId(): number {
+    const i = this.nextId;
+    this.nextId = this.nextId >= 0xfffffff0 ? 1 : this.nextId + 1;
+    return i;
+  }
+
+  private markReady(): void {
+    this.loaded = true;
+    this.readySince = performance.now();
+  }
+
+  // --- Launching ------------------------------------------------------------------------------
 
   /** Starts a process and loads the module; resolves when ready, rejects with a PythonLoadError. */
-  const launch = async (): Promise<void> => {
-    const cmd = await command(cwd);
-    const p = new Proc(
-      cmd,
-      cwd,
-      (type, callId, payload) => {
-        if (p === proc) onCall(type, callId, payload);
-      },
-      (line) => {
-        if (p === proc && !closed) o.onOutput?.(line);
-      },
-      (reason) => {
-        // While loading, `launch` itself fails (and its caller decides); once ready, a restart.
-        if (p === proc && ready) crashed(reason);
-      },
-    );
-    proc = p;
+  private async launch(): Promise<void> {
+    const cmd = await this.settings.command(this.cwd);
+    const p = this.spawn(cmd);
+    this.proc = p;
     let timer: ReturnType<typeof setTimeout> | undefined;
     const timeout = new Promise<never>((_, reject) => {
-      timer = setTimeout(() => {
-        reject(
-          new PythonLoadError(
-            `the Python sidecar did not load ${o.module} within ${formatS(loadTimeoutMs)}`,
-            "start",
-          ),
-        );
-      }, loadTimeoutMs);
+      timer = setTimeout(() => reject(this.loadTimedOut()), this.settings.loadTimeoutMs);
     });
-    const startFailed = (what: string): PythonLoadError => {
-      const tail = p.stderr();
-      const hint = /No module named uv|uv: not found|ENOENT|No interpreter found|python3\.11/.test(
-        `${p.exitReason}\n${tail}`,
-      )
-        ? " (install uv and the environment with scripts/setup.sh; Python 3.11 must be on the PATH)"
-        : "";
-      return new PythonLoadError(
-        `the Python sidecar ${what}: ${p.exitReason}${tail ? `\n${tail}` : ""}${hint}`,
-        "start",
-      );
-    };
-    const sequence = async (): Promise<void> => {
-      const h = await p.request(MSG.hello, id());
-      if (h.type !== MSG.hello) throw startFailed("did not start");
-      const info = parseJson(h.payload);
-      version = `Python ${String(info.python)}, NumPy ${String(info.numpy)}`;
-      p.pid = typeof info.pid === "number" ? info.pid : p.child.pid;
-      const l = await p.request(MSG.load, id(), {
-        module: o.module,
-        function: o.function,
-        init: o.init ?? null,
-        params: o.params,
-        input_shape: [o.inputShape.rows, o.inputShape.cols],
-        output_shape: o.outputShape ? [o.outputShape.rows, o.outputShape.cols] : null,
-        cwd,
-        nice,
-        memory_limit_mb: o.memoryLimitMb ?? 0,
-      });
-      if (l.type === MSG.error) {
-        const e = parseJson(l.payload);
-        throw new PythonLoadError(
-          String(e.message ?? "load failed"),
-          String(e.kind ?? "load"),
-          String(e.traceback ?? ""),
-        );
-      }
-      if (l.type !== MSG.ok) throw startFailed("stopped while loading");
-      const shape = parseJson(l.payload).output_shape as [number, number];
-      outputShape = { rows: shape[0], cols: shape[1] };
-      if (shape[0] * shape[1] !== outSize || out.length !== shape[0] * shape[1]) {
-        outSize = shape[0] * shape[1];
-        out = new Float64Array(outSize);
-      }
-    };
     try {
-      await Promise.race([sequence(), timeout]);
+      await Promise.race([this.handshake(p), timeout]);
     } catch (e) {
-      if (proc === p) proc = undefined;
+      if (this.proc === p) this.proc = undefined;
       p.stop();
       throw e;
     } finally {
       clearTimeout(timer);
     }
-  };
+  }
 
-  const crashed = (reason: string): void => {
-    const p = proc;
-    proc = undefined;
-    const wasReady = ready;
-    ready = false;
-    if (closed) return;
-    const lost = inFlight.splice(0);
+  /** A process whose messages, output and exit count only while it is the current one. */
+  private spawn(cmd: SidecarCommand): Proc {
+    const p: Proc = new Proc(
+      cmd,
+      this.cwd,
+      (type, callId, payload) => {
+        if (p === this.proc) this.answered(type, callId, payload);
+      },
+      (line) => {
+        if (p === this.proc && !this.closed) this.o.onOutput?.(line);
+      },
+      (reason) => {
+        // While loading, `launch` itself fails (and its caller decides); once ready, a restart.
+        if (p === this.proc && this.loaded) this.crashed(reason);
+      },
+    );
+    return p;
+  }
+
+  private loadTimedOut(): PythonLoadError {
+    return new PythonLoadError(
+      `the Python sidecar did not load ${this.o.module} within ${formatS(this.settings.loadTimeoutMs)}`,
+      "start",
+    );
+  }
+
+  /** `hello`, then `load` with the block's module and params; adopts the output shape. */
+  private async handshake(p: Proc): Promise<void> {
+    const h = await p.request(MSG.hello, this.newId());
+    if (h.type !== MSG.hello) throw startFailed(p, "did not start");
+    const info = parseJson(h.payload);
+    this.versionText = `Python ${String(info.python)}, NumPy ${String(info.numpy)}`;
+    p.pid = typeof info.pid === "number" ? info.pid : p.child.pid;
+    const l = await p.request(MSG.load, this.newId(), this.loadRequest());
+    if (l.type === MSG.error) {
+      const e = parseJson(l.payload);
+      throw new PythonLoadError(
+        String(e.message ?? "load failed"),
+        String(e.kind ?? "load"),
+        String(e.traceback ?? ""),
+      );
+    }
+    if (l.type !== MSG.ok) throw startFailed(p, "stopped while loading");
+    this.adoptOutputShape(parseJson(l.payload).output_shape as [number, number]);
+  }
+
+  private loadRequest(): Record<string, unknown> {
+    const o = this.o;
+    return {
+      module: o.module,
+      function: o.function,
+      init: o.init ?? null,
+      params: o.params,
+      input_shape: [o.inputShape.rows, o.inputShape.cols],
+      output_shape: o.outputShape ? [o.outputShape.rows, o.outputShape.cols] : null,
+      cwd: this.cwd,
+      nice: this.settings.nice,
+      memory_limit_mb: o.memoryLimitMb ?? 0,
+    };
+  }
+
+  private adoptOutputShape(shape: [number, number]): void {
+    this.shape = { rows: shape[0], cols: shape[1] };
+    const size = shape[0] * shape[1];
+    if (this.out.length !== size) this.out = new Float64Array(size);
+  }
+
+  // --- Calls ----------------------------------------------------------------------------------
+
+  /** A result or error for a call of the current process. */
+  private answered(type: number, callId: number, payload: Buffer): void {
+    this.settle(callId);
+    if (this.closed) return;
+    if (type === MSG.result) this.deliverResult(callId, payload);
+    else if (type === MSG.error) this.deliverError(callId, payload);
+  }
+
+  /** Removes an answered call from the calls in flight (the next one starts its time). */
+  private settle(callId: number): void {
+    const k = this.inFlight.indexOf(callId);
+    if (k < 0) return;
+    this.inFlight.splice(k, 1);
+    if (k === 0) this.headSince = performance.now();
+    for (let i = 0; i < this.resets.length; i++) if (this.resets[i]! > 0) this.resets[i]!--;
+  }
+
+  private deliverResult(callId: number, payload: Buffer): void {
+    const us = payload.length >= 8 ? payload.readDoubleLE(0) : NaN;
+    const n = decodeArrayInto(payload, 8, this.out);
+    if (typeof n === "string") {
+      this.o.onError(callId, {
+        message: `bad result from the sidecar: ${n}`,
+        traceback: "",
+        kind: "protocol",
+      });
+    } else {
+      this.o.onResult(callId, this.out, us);
+    }
+  }
+
+  private deliverError(callId: number, payload: Buffer): void {
+    const e = parseJson(payload);
+    const err: PythonCallError = {
+      message: String(e.message ?? "error"),
+      traceback: String(e.traceback ?? ""),
+      kind: String(e.kind ?? "call"),
+    };
+    this.o.onError(callId, err);
+  }
+
+  /** The answer to a `reset`: the calls that waited for `init` start their time now. */
+  private resetAnswered(p: Proc, type: number, payload: Buffer): void {
+    if (this.proc === p && this.resets.length > 0) {
+      this.resets.shift();
+      if (this.inFlight.length > 0) this.headSince = performance.now();
+    }
+    if (type === MSG.error && !this.closed) {
+      const e = parseJson(payload);
+      this.o.onError(0, {
+        message: `init raised on reset: ${String(e.message)}`,
+        traceback: String(e.traceback ?? ""),
+        kind: "init",
+      });
+    }
+  }
+
+  // --- Watchdog -------------------------------------------------------------------------------
+
+  private startWatchdog(): void {
+    const { hardLimitMs, lateAfterMs } = this;
+    if (hardLimitMs === Infinity && lateAfterMs === Infinity) return;
+    const every = Math.min(lateAfterMs < Infinity ? 50 : 250, Math.max(10, hardLimitMs / 8));
+    this.watchdog = setInterval(() => this.watchCalls(), every);
+    this.watchdog.unref?.();
+  }
+
+  /**
+   * The oldest call in flight: reported while it runs past `lateAfterMs`; past the hard limit
+   * the process is killed (and restarted by `crashed`).
+   */
+  private watchCalls(): void {
+    const p = this.proc;
+    if (!p || !this.loaded || this.closed || this.inFlight.length === 0 || p.cause) return;
+    if (this.resets.length > 0 && this.resets[0] === 0) return; // the oldest call waits behind a reset
+    const running = performance.now() - this.headSince;
+    if (running > this.lateAfterMs) this.o.onLate?.(this.inFlight[0]!, running);
+    if (running <= this.hardLimitMs || this.closed || this.proc !== p) return;
+    this.timedOut = this.inFlight[0]!;
+    p.cause = `a call ran longer than its hard limit of ${formatS(this.hardLimitMs)} (HardLimit)`;
+    p.kill();
+  }
+
+  // --- Crashes and restarts -------------------------------------------------------------------
+
+  /** The current process died: its calls fail, the status says why, a restart is scheduled. */
+  private crashed(reason: string): void {
+    const p = this.proc;
+    this.proc = undefined;
+    const wasReady = this.loaded;
+    this.loaded = false;
+    if (this.closed) return;
+    this.failCallsInFlight(p, reason);
+    this.timedOut = -1;
+    this.resets.length = 0;
+    const backoff = this.settings.backoff;
+    if (wasReady && performance.now() - this.readySince > backoff.max) this.delay = backoff.first;
+    const pid = `the Python process (pid ${p?.pid ?? "?"})`;
+    const cause = p?.cause ?? "";
+    this.o.onStatus(
+      "restarting",
+      `${cause ? `${cause}: ${pid} was killed` : `${pid} ${reason}`}; restarting in ${formatS(this.delay)}`,
+    );
+    this.scheduleRestart();
+  }
+
+  /** Every call in flight fails: "timeout" for the one that passed the hard limit, else "crash". */
+  private failCallsInFlight(p: Proc | undefined, reason: string): void {
+    const lost = this.inFlight.splice(0);
     const tail = p?.stderr(6) ?? "";
     const cause = p?.cause ?? "";
     for (const callId of lost) {
-      const hung = cause !== "" && callId === timedOut;
-      o.onError(callId, {
+      const hung = cause !== "" && callId === this.timedOut;
+      this.o.onError(callId, {
         message: hung
           ? `${cause}: the Python process was killed`
           : `the Python process died (${cause || reason})`,
@@ -597,111 +737,51 @@ async function startSidecar(
         kind: hung ? "timeout" : "crash",
       });
     }
-    timedOut = -1;
-    resets.length = 0;
-    if (wasReady && performance.now() - readySince > backoff.max) delay = backoff.first;
-    const pid = `the Python process (pid ${p?.pid ?? "?"})`;
-    o.onStatus(
-      "restarting",
-      `${cause ? `${cause}: ${pid} was killed` : `${pid} ${reason}`}; restarting in ${formatS(delay)}`,
-    );
-    scheduleRestart();
-  };
-
-  const scheduleRestart = (): void => {
-    if (closed || retry) return;
-    const wait = delay;
-    delay = Math.min(delay * 2, backoff.max);
-    retry = setTimeout(() => {
-      retry = undefined;
-      if (closed) return;
-      launch().then(
-        () => {
-          if (closed) {
-            proc?.stop();
-            return;
-          }
-          ready = true;
-          readySince = performance.now();
-          o.onStatus("ready", `restarted (pid ${proc?.pid ?? "?"})`);
-        },
-        (e: unknown) => {
-          if (closed) return;
-          o.onStatus(
-            "restarting",
-            `restart failed: ${(e as Error).message.split("\n")[0]}; retrying in ${formatS(delay)}`,
-          );
-          scheduleRestart();
-        },
-      );
-    }, wait);
-    retry.unref?.();
-  };
-
-  await launch();
-  ready = true;
-  readySince = performance.now();
-  if (hardLimitMs < Infinity || lateAfterMs < Infinity) {
-    const every = Math.min(lateAfterMs < Infinity ? 50 : 250, Math.max(10, hardLimitMs / 8));
-    watchdog = setInterval(watchCalls, every);
-    watchdog.unref?.();
   }
-  o.onStatus("ready");
 
-  return {
-    get outputShape() {
-      return outputShape;
-    },
-    get pid() {
-      return proc?.pid;
-    },
-    get version() {
-      return version;
-    },
-    get ready() {
-      return ready && !closed;
-    },
-    call(values: Float64Array): number {
-      const p = proc;
-      if (!ready || closed || !p) return -1;
-      const callId = id();
-      if (inFlight.length === 0) headSince = performance.now();
-      inFlight.push(callId);
-      p.write(encodeCall(callId, values, o.inputShape.rows, o.inputShape.cols));
-      return callId;
-    },
-    reset() {
-      const p = proc;
-      if (!ready || closed || !p) return;
-      resets.push(inFlight.length);
-      void p.request(MSG.reset, id()).then(({ type, payload }) => {
-        if (proc === p && resets.length > 0) {
-          resets.shift();
-          // The calls sent meanwhile waited for `init`: their time starts now.
-          if (inFlight.length > 0) headSince = performance.now();
+  private scheduleRestart(): void {
+    if (this.closed || this.retry) return;
+    const wait = this.delay;
+    this.delay = Math.min(this.delay * 2, this.settings.backoff.max);
+    this.retry = setTimeout(() => {
+      this.retry = undefined;
+      if (!this.closed) this.restart();
+    }, wait);
+    this.retry.unref?.();
+  }
+
+  private restart(): void {
+    this.launch().then(
+      () => {
+        if (this.closed) {
+          this.proc?.stop();
+          return;
         }
-        if (type === MSG.error && !closed) {
-          const e = parseJson(payload);
-          o.onError(0, {
-            message: `init raised on reset: ${String(e.message)}`,
-            traceback: String(e.traceback ?? ""),
-            kind: "init",
-          });
-        }
-      });
-    },
-    close() {
-      if (closed) return;
-      closed = true;
-      ready = false;
-      if (retry) clearTimeout(retry);
-      retry = undefined;
-      if (watchdog) clearInterval(watchdog);
-      watchdog = undefined;
-      const p = proc;
-      proc = undefined;
-      p?.stop();
-      o.onStatus("closed");
-    },
-  };
+        this.markReady();
+        this.o.onStatus("ready", `restarted (pid ${this.proc?.pid ?? "?"})`);
+      },
+      (e: unknown) => {
+        if (this.closed) return;
+        this.o.onStatus(
+          "restarting",
+          `restart failed: ${(e as Error).message.split("\n")[0]}; retrying in ${formatS(this.delay)}`,
+        );
+        this.scheduleRestart();
+      },
+    );
+  }
+}
+
+/** A start that failed: the process's exit reason and its last stderr lines, with a setup hint. */
+function startFailed(p: Proc, what: string): PythonLoadError {
+  const tail = p.stderr();
+  const hint = /No module named uv|uv: not found|ENOENT|No interpreter found|python3\.11/.test(
+    `${p.exitReason}\n${tail}`,
+  )
+    ? " (install uv and the environment with scripts/setup.sh; Python 3.11 must be on the PATH)"
+    : "";
+  return new PythonLoadError(
+    `the Python sidecar ${what}: ${p.exitReason}${tail ? `\n${tail}` : ""}${hint}`,
+    "start",
+  );
 }
