@@ -107,61 +107,12 @@ export function soakFigures(
   child: ChildRun | undefined,
   before: number[],
 ): SoakResult {
+  // Each check adds its failures in turn: memory, the sidecar's, datagrams, errors.
   const failures: string[] = [];
-  // Memory over the steady state.
-  const rssMiB = (child?.samples ?? []).filter((s) => s.steady).map((s) => s.rssKiB / 1024);
-  let rss: SoakResult["rss"] = null;
-  if (rssMiB.length > 0) {
-    rss = rssFigures(rssMiB, def.memoryTolerancePct);
-    if (!rss.flat) {
-      failures.push(
-        `VmRSS moved beyond ±${rss.tolerancePct} % over the run: median ${rss.firstMedianMiB} MiB over the first ${rss.windowSamples} s after ${rss.settleSamples} s of settling, ${rss.lastMedianMiB} over the last (${rss.driftPct} %, ${rss.runDriftPct} % at that slope over the whole run)`,
-      );
-    }
-  } else failures.push("no memory samples in the steady state");
-  // The sidecar's memory (its own process, beside the engine's).
-  const side = (child?.samples ?? []).filter((s) => s.steady).map((s) => s.childrenRssKiB / 1024);
-  let sidecarRss: SoakResult["sidecarRss"] = null;
-  if (side.length > 0 && side[0]! > 0) {
-    const start = side[0]!;
-    const end = side[side.length - 1]!;
-    const max = Math.max(...side);
-    sidecarRss = {
-      startMiB: round(start, 1),
-      endMiB: round(end, 1),
-      maxMiB: round(max, 1),
-      driftPct: round(((end - start) / start) * 100, 2),
-    };
-    if (Math.abs(sidecarRss.driftPct) > def.memoryTolerancePct) {
-      failures.push(
-        `the Python sidecar's VmRSS moved beyond ±${def.memoryTolerancePct} %: ${sidecarRss.startMiB} → ${sidecarRss.endMiB} MiB`,
-      );
-    }
-  }
-  // Datagrams: the Sender's own counts against what arrived.
-  const sender = child?.summary?.blocks.find((b) => b.type === "UdpSender");
-  const counts = senderCounts(sender?.text);
-  const received = (run.udp?.datagramsAll ?? 0) + (run.udp?.malformed ?? 0);
-  const uncounted = counts ? counts.sent - received : null;
-  if (counts === null)
-    failures.push(`the Sender's status gives no counts: '${sender?.text ?? ""}'`);
-  else if (uncounted !== 0) {
-    failures.push(`${uncounted} datagrams the Sender counts as sent did not arrive`);
-  }
-  // Errors: counted by the blocks, printed as events, and the exit code.
-  const blocks = (child?.summary?.blocks ?? [])
-    .filter((b) => b.errors > 0)
-    .map((b) => ({ name: b.name, errors: b.errors, lastError: b.lastError }));
-  const total = blocks.reduce((a, b) => a + b.errors, 0);
-  const events = child?.eventsByLevel ?? {};
-  const exitCode = child?.summary?.exitCode ?? child?.exitCode ?? null;
-  const consistent = exitCode === (total > 0 || (events.error ?? 0) > 0 ? 1 : 0);
-  if (!consistent) {
-    failures.push(
-      `errors not accounted for: ${total} counted by blocks, ${events.error ?? 0} error events, exit code ${exitCode}`,
-    );
-  }
-  if (total > 0) failures.push(`${total} block errors (${blocks.map((b) => b.name).join(", ")})`);
+  const rss = engineMemoryCheck(child, def.memoryTolerancePct, failures);
+  const sidecarRss = sidecarMemoryCheck(child, def.memoryTolerancePct, failures);
+  const udp = datagramCheck(run, child, failures);
+  const errors = errorCheck(child, failures);
   const missedTicks = run.timers.reduce((a, t) => a + t.missed, 0);
   if (!child?.summary) failures.push(run.error ?? "the run printed no summary");
   return {
@@ -176,21 +127,107 @@ export function soakFigures(
     steadySeconds: o.steady,
     rss,
     sidecarRss,
-    udp: {
-      sent: counts?.sent ?? null,
-      notSent: counts?.notSent ?? null,
-      notSentReason: counts?.reason ?? "",
-      received,
-      malformed: run.udp?.malformed ?? 0,
-      uncounted,
-    },
+    udp,
     drops: { edges: run.dropsAllTime, missedTicks },
-    errors: { total, blocks, events, exitCode, consistent },
+    errors,
     run,
     loadAvgBefore: before,
     loadAvgAfter: loadAvg(),
     killedAfterSummary: run.killedAfterSummary,
   };
+}
+
+/** The run's 1-s samples in the steady state. */
+function steadySamples(child: ChildRun | undefined): ChildRun["samples"] {
+  return (child?.samples ?? []).filter((s) => s.steady);
+}
+
+/** Memory of the `mosaic run` process over the steady state: flat within the tolerance. */
+function engineMemoryCheck(
+  child: ChildRun | undefined,
+  tolerancePct: number,
+  failures: string[],
+): SoakResult["rss"] {
+  const rssMiB = steadySamples(child).map((s) => s.rssKiB / 1024);
+  if (rssMiB.length === 0) {
+    failures.push("no memory samples in the steady state");
+    return null;
+  }
+  const rss = rssFigures(rssMiB, tolerancePct);
+  if (!rss.flat) {
+    failures.push(
+      `VmRSS moved beyond ±${rss.tolerancePct} % over the run: median ${rss.firstMedianMiB} MiB over the first ${rss.windowSamples} s after ${rss.settleSamples} s of settling, ${rss.lastMedianMiB} over the last (${rss.driftPct} %, ${rss.runDriftPct} % at that slope over the whole run)`,
+    );
+  }
+  return rss;
+}
+
+/** The sidecar's memory (its own process, beside the engine's): start to end within the tolerance. */
+function sidecarMemoryCheck(
+  child: ChildRun | undefined,
+  tolerancePct: number,
+  failures: string[],
+): SoakResult["sidecarRss"] {
+  const side = steadySamples(child).map((s) => s.childrenRssKiB / 1024);
+  if (!(side.length > 0 && side[0]! > 0)) return null;
+  const start = side[0]!;
+  const end = side[side.length - 1]!;
+  const max = Math.max(...side);
+  const sidecarRss = {
+    startMiB: round(start, 1),
+    endMiB: round(end, 1),
+    maxMiB: round(max, 1),
+    driftPct: round(((end - start) / start) * 100, 2),
+  };
+  if (Math.abs(sidecarRss.driftPct) > tolerancePct) {
+    failures.push(
+      `the Python sidecar's VmRSS moved beyond ±${tolerancePct} %: ${sidecarRss.startMiB} → ${sidecarRss.endMiB} MiB`,
+    );
+  }
+  return sidecarRss;
+}
+
+/** Datagrams: the Sender's own counts against what arrived. */
+function datagramCheck(
+  run: PipelineResult,
+  child: ChildRun | undefined,
+  failures: string[],
+): SoakResult["udp"] {
+  const sender = child?.summary?.blocks.find((b) => b.type === "UdpSender");
+  const counts = senderCounts(sender?.text);
+  const received = (run.udp?.datagramsAll ?? 0) + (run.udp?.malformed ?? 0);
+  const uncounted = counts ? counts.sent - received : null;
+  if (counts === null)
+    failures.push(`the Sender's status gives no counts: '${sender?.text ?? ""}'`);
+  else if (uncounted !== 0) {
+    failures.push(`${uncounted} datagrams the Sender counts as sent did not arrive`);
+  }
+  return {
+    sent: counts?.sent ?? null,
+    notSent: counts?.notSent ?? null,
+    notSentReason: counts?.reason ?? "",
+    received,
+    malformed: run.udp?.malformed ?? 0,
+    uncounted,
+  };
+}
+
+/** Errors: counted by the blocks, printed as events, and the exit code, which must agree. */
+function errorCheck(child: ChildRun | undefined, failures: string[]): SoakResult["errors"] {
+  const blocks = (child?.summary?.blocks ?? [])
+    .filter((b) => b.errors > 0)
+    .map((b) => ({ name: b.name, errors: b.errors, lastError: b.lastError }));
+  const total = blocks.reduce((a, b) => a + b.errors, 0);
+  const events = child?.eventsByLevel ?? {};
+  const exitCode = child?.summary?.exitCode ?? child?.exitCode ?? null;
+  const consistent = exitCode === (total > 0 || (events.error ?? 0) > 0 ? 1 : 0);
+  if (!consistent) {
+    failures.push(
+      `errors not accounted for: ${total} counted by blocks, ${events.error ?? 0} error events, exit code ${exitCode}`,
+    );
+  }
+  if (total > 0) failures.push(`${total} block errors (${blocks.map((b) => b.name).join(", ")})`);
+  return { total, blocks, events, exitCode, consistent };
 }
 
 /** The soak's section: the checks, then the figures of its pipeline run in one table. */

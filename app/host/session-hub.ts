@@ -273,23 +273,9 @@ export class SessionHub {
       case "hello":
         this.hello = m;
         return;
-      case "reply": {
-        const p = this.pending.get(m.id);
-        this.pending.delete(m.id);
-        if (!p) return;
-        p.done?.();
-        if (m.graph !== undefined && m.ok) this.graph = m.graph;
-        else if (m.diagnostics !== undefined && !m.ok) this.graph = undefined;
-        const reply: Reply = { ...m, id: p.clientId };
-        p.resolve?.(reply);
-        if (p.client?.open) p.client.sink.send(reply);
-        // A pipeline loaded by one client is every client's: the others get the graph too.
-        if (m.graph !== undefined && m.ok) {
-          for (const c of this.clients)
-            if (c !== p.client) c.sink.send({ type: "graph", graph: m.graph });
-        }
+      case "reply":
+        this.onReply(m);
         return;
-      }
       case "state":
         this.lastState = m;
         if (m.state === "empty") this.graph = undefined;
@@ -309,30 +295,15 @@ export class SessionHub {
         this.graph = m.graph;
         this.broadcast(m);
         return;
-      case "data": {
-        const holders = this.watchers.get(watchKey(m.block, m.port));
-        if (holders) for (const c of holders) if (c.open) c.sink.send(m);
+      case "data":
+        this.onData(m);
         return;
-      }
-      case "log-open": {
-        let writer = this.writers.get(m.baseDir);
-        if (!writer) {
-          writer = new LogWriter(m.baseDir, {
-            onError: (file, message) => this.problem(`log ${file}: ${message}`),
-          });
-          this.writers.set(m.baseDir, writer);
-        }
-        const key = `log:${m.id}`;
-        writer.open(key, m.block, m.port, m.isDefaultPort, m.path, m.shape, m.ring);
-        this.logs.set(m.id, { writer, key });
+      case "log-open":
+        this.onLogOpen(m);
         return;
-      }
-      case "log-close": {
-        const l = this.logs.get(m.id);
-        this.logs.delete(m.id);
-        l?.writer.close(l.key);
+      case "log-close":
+        this.onLogClose(m);
         return;
-      }
       case "serial":
         this.serial.receive(m);
         return;
@@ -340,6 +311,50 @@ export class SessionHub {
         this.ble.receive(m);
         return;
     }
+  }
+
+  /** The engine's answer to a pending request: to its client (or `request`'s promise), under its id. */
+  private onReply(m: Extract<SessionToHub, { type: "reply" }>): void {
+    const p = this.pending.get(m.id);
+    this.pending.delete(m.id);
+    if (!p) return;
+    p.done?.();
+    if (m.graph !== undefined && m.ok) this.graph = m.graph;
+    else if (m.diagnostics !== undefined && !m.ok) this.graph = undefined;
+    const reply: Reply = { ...m, id: p.clientId };
+    p.resolve?.(reply);
+    if (p.client?.open) p.client.sink.send(reply);
+    // A pipeline loaded by one client is every client's: the others get the graph too.
+    if (m.graph !== undefined && m.ok) {
+      for (const c of this.clients)
+        if (c !== p.client) c.sink.send({ type: "graph", graph: m.graph });
+    }
+  }
+
+  /** Panel data: to the open clients watching that output. */
+  private onData(m: Extract<SessionToHub, { type: "data" }>): void {
+    const holders = this.watchers.get(watchKey(m.block, m.port));
+    if (holders) for (const c of holders) if (c.open) c.sink.send(m);
+  }
+
+  /** A `Path` log opens: written here, by one LogWriter per base folder. */
+  private onLogOpen(m: Extract<SessionToHub, { type: "log-open" }>): void {
+    let writer = this.writers.get(m.baseDir);
+    if (!writer) {
+      writer = new LogWriter(m.baseDir, {
+        onError: (file, message) => this.problem(`log ${file}: ${message}`),
+      });
+      this.writers.set(m.baseDir, writer);
+    }
+    const key = `log:${m.id}`;
+    writer.open(key, m.block, m.port, m.isDefaultPort, m.path, m.shape, m.ring);
+    this.logs.set(m.id, { writer, key });
+  }
+
+  private onLogClose(m: Extract<SessionToHub, { type: "log-close" }>): void {
+    const l = this.logs.get(m.id);
+    this.logs.delete(m.id);
+    l?.writer.close(l.key);
   }
 
   /** Sends a request on behalf of the hub itself (not a client) and waits for the reply. */

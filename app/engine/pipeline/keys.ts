@@ -60,6 +60,12 @@ export interface BlockKeys {
   paramsPos: SourcePos;
 }
 
+/** One key of a block's map: its value node and where the key is. */
+interface KeyEntry {
+  node: unknown;
+  keyPos: SourcePos;
+}
+
 /** Stage 3 for one block (`at`: where its name is). */
 export function readBlockKeys(
   c: Collector,
@@ -69,23 +75,8 @@ export function readBlockKeys(
   catalog: Catalog,
   view: MosaicView,
 ): BlockKeys {
-  const get = (k: string): { node: unknown; keyPos: SourcePos } | undefined => {
-    const p = map.items.find((it) => scalarString(it.key) === k);
-    return p ? { node: p.value, keyPos: c.pos(p.key as YamlNode) } : undefined;
-  };
-  const ignored = new Set(view.ignored.map((p) => p.key));
-  for (const it of map.items) {
-    if (ignored.has(it.key)) continue;
-    const k = scalarString(it.key) ?? "";
-    if (!(BLOCK_KEYS as readonly string[]).includes(k)) {
-      const suggestion = closest(k, BLOCK_KEYS);
-      c.error("unknown-key", c.pos(it.key as YamlNode), `block '${name}': unknown key '${k}'`, {
-        block: name,
-        expected: `one of ${BLOCK_KEYS.join(", ")}`,
-        ...(suggestion !== undefined ? { suggestion } : {}),
-      });
-    }
-  }
+  const get = (k: string): KeyEntry | undefined => keyEntry(c, map, k);
+  reportUnknownKeys(c, name, map, view);
 
   const t = readType(c, name, at, get("Type")?.node, get("Type") !== undefined, catalog);
   const { def, rule } = t;
@@ -95,29 +86,7 @@ export function readBlockKeys(
   const inputsPos = inputsEntry ? c.pos(inputsEntry.node as YamlNode) : at;
   const inputs = inputsEntry ? readInputs(c, name, inputsEntry.node, inputsPos) : [];
 
-  let path: string | undefined;
-  const pathEntry = get("Path");
-  if (pathEntry) {
-    if (pathEntry.node === view.emptyPath && view.emptyPath) {
-      emptyPathWarning(c, name, view.emptyPath);
-      path = EMPTY_PATH;
-    } else path = readPath(c, name, pathEntry.node);
-  }
-
-  let worker = "main";
-  const workerEntry = get("Worker");
-  if (workerEntry) worker = readWorker(c, name, workerEntry.node) ?? worker;
-
-  const batchingEntry = get("BatchingMs");
-  const batchingMs = batchingEntry ? readBatchingMs(c, batchingEntry.node, name) : undefined;
-
-  const queueEntry = get("Queue");
-  const queue = queueEntry
-    ? readQueue(c, name, queueEntry.node)
-    : { policy: "drop-oldest" as QueuePolicy, capacity: undefined };
-
-  const layoutEntry = get("Layout");
-  const layout = layoutEntry ? readLayout(c, name, layoutEntry.node) : undefined;
+  const { path, worker, batchingMs, queue, layout } = readRunKeys(c, name, get, view);
 
   const paramsEntry = get("Params");
   return {
@@ -138,6 +107,70 @@ export function readBlockKeys(
     paramsNode: paramsEntry?.node,
     paramsPos: paramsEntry ? c.pos(paramsEntry.node as YamlNode) : at,
   };
+}
+
+/** The key `k` of a block's map, undefined when the block has none. */
+function keyEntry(c: Collector, map: YAMLMap, k: string): KeyEntry | undefined {
+  const p = map.items.find((it) => scalarString(it.key) === k);
+  return p ? { node: p.value, keyPos: c.pos(p.key as YamlNode) } : undefined;
+}
+
+/** One error per key that is not a block key (stage 2's ignored keys aside), in file order. */
+function reportUnknownKeys(c: Collector, name: string, map: YAMLMap, view: MosaicView): void {
+  const ignored = new Set(view.ignored.map((p) => p.key));
+  for (const it of map.items) {
+    if (ignored.has(it.key)) continue;
+    const k = scalarString(it.key) ?? "";
+    if (!(BLOCK_KEYS as readonly string[]).includes(k)) {
+      const suggestion = closest(k, BLOCK_KEYS);
+      c.error("unknown-key", c.pos(it.key as YamlNode), `block '${name}': unknown key '${k}'`, {
+        block: name,
+        expected: `one of ${BLOCK_KEYS.join(", ")}`,
+        ...(suggestion !== undefined ? { suggestion } : {}),
+      });
+    }
+  }
+}
+
+/** Path, Worker, BatchingMs, Queue and Layout, in that order (so are their errors). */
+function readRunKeys(
+  c: Collector,
+  name: string,
+  get: (k: string) => KeyEntry | undefined,
+  view: MosaicView,
+): Pick<BlockKeys, "path" | "worker" | "batchingMs" | "queue" | "layout"> {
+  const pathEntry = get("Path");
+  const path = pathEntry ? readBlockPath(c, name, pathEntry.node, view) : undefined;
+
+  let worker = "main";
+  const workerEntry = get("Worker");
+  if (workerEntry) worker = readWorker(c, name, workerEntry.node) ?? worker;
+
+  const batchingEntry = get("BatchingMs");
+  const batchingMs = batchingEntry ? readBatchingMs(c, batchingEntry.node, name) : undefined;
+
+  const queueEntry = get("Queue");
+  const queue = queueEntry
+    ? readQueue(c, name, queueEntry.node)
+    : { policy: "drop-oldest" as QueuePolicy, capacity: undefined };
+
+  const layoutEntry = get("Layout");
+  const layout = layoutEntry ? readLayout(c, name, layoutEntry.node) : undefined;
+  return { path, worker, batchingMs, queue, layout };
+}
+
+/** A present Path: MOSAIC's empty Path (stage 2 found it) is a warning and EMPTY_PATH. */
+function readBlockPath(
+  c: Collector,
+  name: string,
+  node: unknown,
+  view: MosaicView,
+): string | undefined {
+  if (node === view.emptyPath && view.emptyPath) {
+    emptyPathWarning(c, name, view.emptyPath);
+    return EMPTY_PATH;
+  }
+  return readPath(c, name, node);
 }
 
 interface TypeResult {

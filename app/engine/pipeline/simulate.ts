@@ -555,10 +555,25 @@ export function simulateDevices(
   catalog: Catalog,
   options: SimulateOptions = {},
 ): SimulationResult {
-  const keepNetwork = options.keepNetwork === true;
+  const env = simulationEnv(spec, options.keepNetwork === true);
+  // Copies, so that the caller's spec stays as loaded.
+  const blocks: BlockSpec[] = spec.blocks.map((b) => ({
+    ...b,
+    inputs: b.inputs.map((i) => ({ ...i })),
+  }));
+  const { out, portMaps, diagnostics, substituted } = substituteDevices(blocks, env, catalog);
+  const byName = rewireInputs(out, portMaps);
+  return { spec: { ...spec, blocks: out, byName }, diagnostics, substituted };
+}
+
+/** Where each output port of a substituted device now comes from, by the device's name. */
+type PortMaps = Map<string, Record<string, { block: string; port: string }>>;
+
+/** What the rules may ask about `spec`; `freshName` reserves the names it hands out. */
+function simulationEnv(spec: PipelineSpec, keepNetwork: boolean): SimulationEnv {
   const names = new Set(spec.blocks.map((b) => b.name));
   const { read, byType } = indexOf(spec);
-  const env: SimulationEnv = {
+  return {
     spec,
     keepNetwork,
     rateOf: (block) => spec.byName.get(block)?.desiredRate,
@@ -571,30 +586,40 @@ export function simulateDevices(
     consumed: (block, port) => read.has(port === undefined ? block : `${block}.${port}`),
     ofType: (type) => byType.get(type) ?? [],
   };
+}
+
+/** The info line of one device block, at the block. */
+function simulatedInfo(spec: PipelineSpec, b: BlockSpec, message: string): Diagnostic {
+  return {
+    severity: "info",
+    code: "simulated-device",
+    message,
+    file: spec.file,
+    line: b.pos.line,
+    col: b.pos.col,
+    block: b.name,
+  };
+}
+
+/**
+ * Puts each device block's replacement in its place, in file order (blocks without a rule, kept
+ * network blocks and those a rule leaves are kept as they are), with one info line per device.
+ */
+function substituteDevices(
+  blocks: BlockSpec[],
+  env: SimulationEnv,
+  catalog: Catalog,
+): { out: BlockSpec[]; portMaps: PortMaps; diagnostics: Diagnostic[]; substituted: string[] } {
   const diagnostics: Diagnostic[] = [];
   const substituted: string[] = [];
-  const info = (b: BlockSpec, message: string): void => {
-    diagnostics.push({
-      severity: "info",
-      code: "simulated-device",
-      message,
-      file: spec.file,
-      line: b.pos.line,
-      col: b.pos.col,
-      block: b.name,
-    });
-  };
-
-  // Copies, so that the caller's spec stays as loaded.
-  const blocks: BlockSpec[] = spec.blocks.map((b) => ({
-    ...b,
-    inputs: b.inputs.map((i) => ({ ...i })),
-  }));
   const out: BlockSpec[] = [];
-  const portMaps = new Map<string, Record<string, { block: string; port: string }>>();
+  const portMaps: PortMaps = new Map();
+  const info = (b: BlockSpec, message: string): void => {
+    diagnostics.push(simulatedInfo(env.spec, b, message));
+  };
   for (const b of blocks) {
     const rule = Object.hasOwn(SIMULATED_DEVICES, b.type) ? SIMULATED_DEVICES[b.type] : undefined;
-    if (!rule || (keepNetwork && rule.network)) {
+    if (!rule || (env.keepNetwork && rule.network)) {
       out.push(b);
       continue;
     }
@@ -612,27 +637,40 @@ export function simulateDevices(
       : "simulated by";
     info(b, `block '${b.name}' (${b.type}) ${verb} ${r.summary}`);
   }
+  return { out, portMaps, diagnostics, substituted };
+}
 
-  // Inputs that named a substituted block: its ports may now come from other blocks.
+/**
+ * Points the inputs that named a substituted block at where its ports now come from (in place),
+ * and gives a new block's inputs their default port. Returns the blocks by name.
+ */
+function rewireInputs(out: BlockSpec[], portMaps: PortMaps): Map<string, BlockSpec> {
   const byName = new Map(out.map((b) => [b.name, b]));
   for (const b of out) {
-    for (const inp of b.inputs) {
-      // A new block's inputs name blocks: their default port.
-      if (inp.port === "") inp.port = byName.get(inp.block)?.outputs[0] ?? "out";
-      const map = portMaps.get(inp.block);
-      if (!map) continue;
-      const to = map[inp.port] ?? {
-        block: inp.block,
-        port: byName.get(inp.block)?.outputs[0] ?? "out",
-      };
-      if (to.block === inp.block && to.port === inp.port) continue;
-      const target = byName.get(to.block);
-      inp.block = to.block;
-      inp.port = to.port;
-      inp.source = target && target.outputs[0] === to.port ? to.block : `${to.block}.${to.port}`;
-    }
+    for (const inp of b.inputs) rewireInput(inp, byName, portMaps);
   }
-  return { spec: { ...spec, blocks: out, byName }, diagnostics, substituted };
+  return byName;
+}
+
+/** One input of `rewireInputs`. */
+function rewireInput(
+  inp: InputRef,
+  byName: ReadonlyMap<string, BlockSpec>,
+  portMaps: PortMaps,
+): void {
+  // A new block's inputs name blocks: their default port.
+  if (inp.port === "") inp.port = byName.get(inp.block)?.outputs[0] ?? "out";
+  const map = portMaps.get(inp.block);
+  if (!map) return;
+  const to = map[inp.port] ?? {
+    block: inp.block,
+    port: byName.get(inp.block)?.outputs[0] ?? "out",
+  };
+  if (to.block === inp.block && to.port === inp.port) return;
+  const target = byName.get(to.block);
+  inp.block = to.block;
+  inp.port = to.port;
+  inp.source = target && target.outputs[0] === to.port ? to.block : `${to.block}.${to.port}`;
 }
 
 /** The BlockSpec of a substitution's block: validated params, the device's place in the file. */
