@@ -8,9 +8,13 @@ import {
   LegacyParamsError,
   matrixShape,
   vectorShape,
+  type BlockContext,
+  type BlockInstance,
+  type OutputPort,
+  type Shape,
 } from "../../engine";
 import { createPythonModule, innerContext } from "../io/python-backed";
-import { inputName, signalInput } from "../shared/inputs";
+import { inputName, signalInput, type SignalInput } from "../shared/inputs";
 
 const params = z
   .strictObject({
@@ -88,6 +92,8 @@ const params = z
     path: ["Outputs"],
   });
 
+type Params = z.output<typeof params>;
+
 export const INmf = defineBlock({
   type: "iNMF",
   category: "Learning",
@@ -146,51 +152,11 @@ export const INmf = defineBlock({
   views: ["scope", "spider", "label"],
   panel: "The synergy activations; the sidecar's state and call times.",
   async create(ctx, p) {
-    const up = signalInput(ctx, 0);
-    const samples = ctx.inputs.length > 1 ? signalInput(ctx, 1) : null;
-    const m = up.shape.cols;
-    if (samples && samples.shape.cols !== m) {
-      throw new BlockConfigError(
-        `the samples input ${inputName(samples.info)} has ${samples.shape.cols} values per row, the ` +
-          `updates input ${inputName(up.info)} ${m}: they must match`,
-      );
-    }
-    if (p.Features !== undefined && p.Features !== m) {
-      throw new BlockConfigError(
-        `Features is ${p.Features}, but the inputs carry ${m} values per row`,
-        "Features",
-      );
-    }
+    const { samples, m, R } = checkInputs(ctx, p);
     const k = p.Outputs ?? p.Synergies;
-    const R = Math.max(up.shape.rows, samples?.shape.rows ?? 1);
     const W = 1 + m;
     const out = ctx.output(vectorShape(k));
-    // The Python function sees [R, 1 + m] (a flag per row) and returns [1, 1 + k] (emit?, h).
-    const inner = await createPythonModule(
-      innerContext(ctx, matrixShape(R, W), (f) => {
-        if (f.v[0] !== 1) return;
-        const o = out.frame(1);
-        o.t[0] = f.t[0]!;
-        o.v.set(f.v.subarray(1, 1 + k));
-        out.emit(o);
-      }),
-      {
-        module: "mosaic_blocks.inmf",
-        init: "init",
-        function: "step",
-        params: {
-          n_synergies: p.Synergies,
-          forgetting: p.Forgetting,
-          outputs: k,
-          solver: p.Solver,
-          w_iters: p.WIters,
-          h_iters: p.HIters,
-          seed: p.Seed,
-        },
-        outputShape: [1, 1 + k],
-        onError: "skip",
-      },
-    );
+    const inner = await startModule(ctx, p, matrixShape(R, W), k, out);
     let update = p.Update;
     let x = new Frame(matrixShape(R, W), 8);
     return {
@@ -201,24 +167,9 @@ export const INmf = defineBlock({
         const predict = samples !== null && port === 1;
         if (!predict && samples !== null && !update) return;
         if (x.capacity < n) x = new Frame(matrixShape(R, W), n);
-        const rows = f.rows;
         // One input: learn and emit (or only emit while Update is off); two: learn, or emit.
         const flag = predict ? 0 : samples === null ? (update ? 2 : 0) : 1;
-        x.n = n;
-        const xv = x.v;
-        for (let e = 0; e < n; e++) {
-          x.t[e] = f.t[e]!;
-          const base = e * R * W;
-          for (let r = 0; r < R; r++) {
-            const at = base + r * W;
-            if (r < rows) {
-              xv[at] = flag;
-              xv.set(f.v.subarray((e * rows + r) * m, (e * rows + r + 1) * m), at + 1);
-            } else {
-              xv.fill(NaN, at, at + W);
-            }
-          }
-        }
+        packRows(f, x, R, m, flag);
         inner.process?.(x, 0);
       },
       setParam(name, value) {
@@ -227,3 +178,93 @@ export const INmf = defineBlock({
     };
   },
 });
+
+/**
+ * Checks the inputs: the samples input (null with one input) and `Features` must match the
+ * updates input's values per row. Returns m, the values per row, and R, the rows per event handed
+ * to Python (the taller input's).
+ */
+function checkInputs(
+  ctx: BlockContext,
+  p: Params,
+): { samples: SignalInput | null; m: number; R: number } {
+  const up = signalInput(ctx, 0);
+  const samples = ctx.inputs.length > 1 ? signalInput(ctx, 1) : null;
+  const m = up.shape.cols;
+  if (samples && samples.shape.cols !== m) {
+    throw new BlockConfigError(
+      `the samples input ${inputName(samples.info)} has ${samples.shape.cols} values per row, the ` +
+        `updates input ${inputName(up.info)} ${m}: they must match`,
+    );
+  }
+  if (p.Features !== undefined && p.Features !== m) {
+    throw new BlockConfigError(
+      `Features is ${p.Features}, but the inputs carry ${m} values per row`,
+      "Features",
+    );
+  }
+  return { samples, m, R: Math.max(up.shape.rows, samples?.shape.rows ?? 1) };
+}
+
+/**
+ * Starts the sidecar's `mosaic_blocks.inmf`: its function sees `input`, [R, 1 + m] (a flag per
+ * row), and returns [1, 1 + k] (emit?, h); the k activations of each result to emit go out.
+ */
+function startModule(
+  ctx: BlockContext,
+  p: Params,
+  input: Shape,
+  k: number,
+  out: OutputPort,
+): Promise<BlockInstance> {
+  return createPythonModule(
+    innerContext(ctx, input, (f) => {
+      if (f.v[0] !== 1) return;
+      const o = out.frame(1);
+      o.t[0] = f.t[0]!;
+      o.v.set(f.v.subarray(1, 1 + k));
+      out.emit(o);
+    }),
+    {
+      module: "mosaic_blocks.inmf",
+      init: "init",
+      function: "step",
+      params: {
+        n_synergies: p.Synergies,
+        forgetting: p.Forgetting,
+        outputs: k,
+        solver: p.Solver,
+        w_iters: p.WIters,
+        h_iters: p.HIters,
+        seed: p.Seed,
+      },
+      outputShape: [1, 1 + k],
+      onError: "skip",
+    },
+  );
+}
+
+/**
+ * Writes the events of `f` into `x` (R rows of 1 + m per event): each of the frame's rows as
+ * [flag, its m values], the rows past them NaN.
+ */
+function packRows(f: Frame, x: Frame, R: number, m: number, flag: number): void {
+  const n = f.n;
+  const rows = f.rows;
+  const W = 1 + m;
+  x.n = n;
+  const xv = x.v;
+  for (let e = 0; e < n; e++) {
+    x.t[e] = f.t[e]!;
+    const base = e * R * W;
+    for (let r = 0; r < R; r++) {
+      const at = base + r * W;
+      if (r < rows) {
+        xv[at] = flag;
+        xv.set(f.v.subarray((e * rows + r) * m, (e * rows + r + 1) * m), at + 1);
+      } else {
+        xv.fill(NaN, at, at + W);
+      }
+    }
+  }
+}

@@ -21,6 +21,7 @@ import {
   LearningModel,
   type ModelKindName,
   type ResolvedLearningOptions,
+  type StateSection,
 } from "../../engine/dsp";
 
 export const MODEL_FORMAT = "mosaic-model";
@@ -378,81 +379,145 @@ export function serializeModel(model: LearningModel, meta: ModelFileMeta): strin
     );
   }
   const p = model.dim;
-  const m = o.outputs;
-  const d = o.inputs;
-  const state = model.saveState();
-  const at: Record<string, number> = {};
-  let k = 0;
-  for (const s of model.stateSections()) {
-    at[s.name] = k;
-    k += s.length;
-  }
-  const r2 = new Float64Array(m);
+  const w = new StateWriter(o, p, model.saveState(), model.stateSections());
+  const r2 = new Float64Array(o.outputs);
   model.r2(r2);
-  const rff = o.kind === "rff";
-  const sec = (name: string): number => {
-    const i = at[name];
+  const lines = w.header(meta, r2);
+  lines.push(w.model(), w.normalizer(), w.stats());
+  return `{\n${lines.join(",\n")}\n}\n`;
+}
+
+/**
+ * One line of the file's top-level object: `"key": value`, the value written as is (JSON text, a
+ * number or a boolean).
+ */
+const field = (key: string, value: unknown): string =>
+  `  ${JSON.stringify(key)}: ${value as string}`;
+
+/** Indentation of the arrays inside the file's "model" and "state" objects. */
+const IND = "    ";
+
+/** Writes a model's flat state, section by section, as the file's header and arrays. */
+class StateWriter {
+  /** Offset of each section in the flat state. */
+  private readonly at: Record<string, number> = {};
+  private readonly d: number;
+  private readonly m: number;
+  private readonly rff: boolean;
+
+  constructor(
+    private readonly o: ResolvedLearningOptions,
+    /** Columns of the normal equations: features for rff, else inputs (the model's `dim`). */
+    private readonly p: number,
+    private readonly state: Float64Array,
+    sections: readonly StateSection[],
+  ) {
+    this.d = o.inputs;
+    this.m = o.outputs;
+    this.rff = o.kind === "rff";
+    let k = 0;
+    for (const s of sections) {
+      this.at[s.name] = k;
+      k += s.length;
+    }
+  }
+
+  /** The flat header: format, options, samples seen, R² and where the model came from. */
+  header(meta: ModelFileMeta, r2: Float64Array): string[] {
+    const { o, rff, state } = this;
+    const meta3 = this.of("meta");
+    return [
+      field("format", JSON.stringify(MODEL_FORMAT)),
+      field("version", MODEL_VERSION),
+      field("kind", JSON.stringify(o.kind)),
+      field("inputs", this.d),
+      field("outputs", this.m),
+      field("lambda", num(o.lambda)),
+      field("gamma", rff ? num(o.gamma) : "null"),
+      field("D", rff ? o.features : "null"),
+      field("seed", rff ? o.seed : "null"),
+      field("forgetting", num(o.forgetting)),
+      field("intercept", o.intercept),
+      field("normalize", o.normalize),
+      field("normalizeSamples", rff && o.normalize ? o.normalizeSamples : "null"),
+      field("samplesSeen", state[meta3]!),
+      field("lambdaEffective", num(state[meta3 + 2]!)),
+      field("r2", vector(r2)),
+      field("created", JSON.stringify(meta.created)),
+      field("block", meta.block !== undefined ? JSON.stringify(meta.block) : "null"),
+      field("blockType", meta.blockType !== undefined ? JSON.stringify(meta.blockType) : "null"),
+      field(
+        "inputSource",
+        meta.inputSource !== undefined ? JSON.stringify(meta.inputSource) : "null",
+      ),
+      field(
+        "targetSource",
+        meta.targetSource !== undefined ? JSON.stringify(meta.targetSource) : "null",
+      ),
+      field("featureNames", meta.featureNames ? JSON.stringify(meta.featureNames) : "null"),
+    ];
+  }
+
+  /** `"model"`: the weights, intercept and penalty, and for rff Ω and the offsets b. */
+  model(): string {
+    const { p, m, d } = this;
+    const parts = [
+      `${IND}"weights": ${this.matrix("weights", p, m)}`,
+      `${IND}"intercept": ${this.vector("intercept", m)}`,
+      `${IND}"penalty": ${this.vector("penalty", p)}`,
+    ];
+    if (this.rff) {
+      parts.push(`${IND}"omega": ${this.matrix("omega", p, d)}`);
+      parts.push(`${IND}"offset": ${this.vector("offset", p)}`);
+    }
+    return `  "model": {\n${parts.join(",\n")}\n  }`;
+  }
+
+  /** `"normalizer"`: the input normalizer's count, frozen flag, means and M2; null without one. */
+  normalizer(): string {
+    if (!this.o.normalize) return `  "normalizer": null`;
+    const { d, state } = this;
+    const n0 = this.of("normalizer");
+    return (
+      `  "normalizer": {"count": ${num(state[n0]!)}, "frozen": ${state[n0 + 1] === 1}, ` +
+      `"mean": ${vector(state, n0 + 2, n0 + 2 + d)}, "m2": ${vector(state, n0 + 2 + d, n0 + 2 + 2 * d)}}`
+    );
+  }
+
+  /** `"state"`: the normal equations and the fit statistics, to go on learning from. */
+  stats(): string {
+    const { p, m, state } = this;
+    const meta3 = this.of("meta");
+    const f0 = this.of("fit_stats");
+    const parts = [
+      `${IND}"weightSum": ${num(state[meta3 + 1]!)}`,
+      `${IND}"xMean": ${this.vector("x_mean", p)}`,
+      `${IND}"yMean": ${this.vector("y_mean", m)}`,
+      `${IND}"scatter": ${this.matrix("scatter", p, p)}`,
+      `${IND}"cross": ${this.matrix("cross", p, m)}`,
+      `${IND}"fitStats": {"weight": ${num(state[f0]!)}, "mean": ${vector(state, f0 + 1, f0 + 1 + m)}, ` +
+        `"m2": ${vector(state, f0 + 1 + m, f0 + 1 + 2 * m)}, "sse": ${vector(state, f0 + 1 + 2 * m, f0 + 1 + 3 * m)}}`,
+    ];
+    return `  "state": {\n${parts.join(",\n")}\n  }`;
+  }
+
+  /** Offset of section `name` in the flat state; an error when the model has none. */
+  private of(name: string): number {
+    const i = this.at[name];
     if (i === undefined) throw new Error(`model state has no section '${name}'`);
     return i;
-  };
-  const meta3 = sec("meta");
-  const h = (key: string, value: unknown): string => `  ${JSON.stringify(key)}: ${value as string}`;
-  const lines: string[] = [
-    h("format", JSON.stringify(MODEL_FORMAT)),
-    h("version", MODEL_VERSION),
-    h("kind", JSON.stringify(o.kind)),
-    h("inputs", d),
-    h("outputs", m),
-    h("lambda", num(o.lambda)),
-    h("gamma", rff ? num(o.gamma) : "null"),
-    h("D", rff ? o.features : "null"),
-    h("seed", rff ? o.seed : "null"),
-    h("forgetting", num(o.forgetting)),
-    h("intercept", o.intercept),
-    h("normalize", o.normalize),
-    h("normalizeSamples", rff && o.normalize ? o.normalizeSamples : "null"),
-    h("samplesSeen", state[meta3]!),
-    h("lambdaEffective", num(state[meta3 + 2]!)),
-    h("r2", vector(r2)),
-    h("created", JSON.stringify(meta.created)),
-    h("block", meta.block !== undefined ? JSON.stringify(meta.block) : "null"),
-    h("blockType", meta.blockType !== undefined ? JSON.stringify(meta.blockType) : "null"),
-    h("inputSource", meta.inputSource !== undefined ? JSON.stringify(meta.inputSource) : "null"),
-    h("targetSource", meta.targetSource !== undefined ? JSON.stringify(meta.targetSource) : "null"),
-    h("featureNames", meta.featureNames ? JSON.stringify(meta.featureNames) : "null"),
-  ];
-  const ind = "    ";
-  const model_: string[] = [
-    `${ind}"weights": ${matrix(state, sec("weights"), p, m, ind)}`,
-    `${ind}"intercept": ${vector(state, sec("intercept"), sec("intercept") + m)}`,
-    `${ind}"penalty": ${vector(state, sec("penalty"), sec("penalty") + p)}`,
-  ];
-  if (rff) {
-    model_.push(`${ind}"omega": ${matrix(state, sec("omega"), p, d, ind)}`);
-    model_.push(`${ind}"offset": ${vector(state, sec("offset"), sec("offset") + p)}`);
   }
-  lines.push(`  "model": {\n${model_.join(",\n")}\n  }`);
-  if (o.normalize) {
-    const n0 = sec("normalizer");
-    lines.push(
-      `  "normalizer": {"count": ${num(state[n0]!)}, "frozen": ${state[n0 + 1] === 1}, ` +
-        `"mean": ${vector(state, n0 + 2, n0 + 2 + d)}, "m2": ${vector(state, n0 + 2 + d, n0 + 2 + 2 * d)}}`,
-    );
-  } else {
-    lines.push(`  "normalizer": null`);
+
+  /** The first `length` values of section `name`, as a JSON array. */
+  private vector(name: string, length: number): string {
+    const i = this.of(name);
+    return vector(this.state, i, i + length);
   }
-  const f0 = sec("fit_stats");
-  const st: string[] = [
-    `${ind}"weightSum": ${num(state[meta3 + 1]!)}`,
-    `${ind}"xMean": ${vector(state, sec("x_mean"), sec("x_mean") + p)}`,
-    `${ind}"yMean": ${vector(state, sec("y_mean"), sec("y_mean") + m)}`,
-    `${ind}"scatter": ${matrix(state, sec("scatter"), p, p, ind)}`,
-    `${ind}"cross": ${matrix(state, sec("cross"), p, m, ind)}`,
-    `${ind}"fitStats": {"weight": ${num(state[f0]!)}, "mean": ${vector(state, f0 + 1, f0 + 1 + m)}, ` +
-      `"m2": ${vector(state, f0 + 1 + m, f0 + 1 + 2 * m)}, "sse": ${vector(state, f0 + 1 + 2 * m, f0 + 1 + 3 * m)}}`,
-  ];
-  lines.push(`  "state": {\n${st.join(",\n")}\n  }`);
-  return `{\n${lines.join(",\n")}\n}\n`;
+
+  /** Section `name` as a rows × cols JSON matrix, one row per line. */
+  private matrix(name: string, rows: number, cols: number): string {
+    return matrix(this.state, this.of(name), rows, cols, IND);
+  }
 }
 
 type Json = unknown;

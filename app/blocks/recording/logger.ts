@@ -3,6 +3,10 @@ import {
   BlockConfigError,
   defineBlock,
   EMPTY_SHAPE,
+  type BlockContext,
+  type BlockInstance,
+  type Frame,
+  type InputInfo,
   type LogChannel,
   type Shape,
 } from "../../engine";
@@ -41,74 +45,106 @@ export const Logger = defineBlock({
   views: ["label"],
   panel: "Lines written per input, the folder, and start/stop buttons.",
   create(ctx, p) {
-    const seen = new Set<string>();
-    for (const i of ctx.inputs) {
-      if (seen.has(i.source)) {
-        throw new BlockConfigError(
-          `input '${i.source}' is listed twice; each input is written to its own file ` +
-            `${i.source}.txt, so list it once`,
-        );
-      }
-      seen.add(i.source);
-    }
+    checkDistinct(ctx.inputs);
     const folder = /[\\/]$/.test(p.Folder) ? p.Folder : `${p.Folder}/`;
-    const shapes: Shape[] = ctx.inputs.map((i) => i.shape ?? EMPTY_SHAPE);
-    let channels: (LogChannel | null)[] = [];
-    let opened = false;
-    let noSink = false;
-    let recording = p.Recording;
-    let lines = 0;
-    const throttle = new TextThrottle();
-    const describe = () => {
-      if (noSink) {
-        ctx.setText("no log sink in this runtime: nothing is recorded");
-        return;
-      }
-      const n = `${lines} line${lines === 1 ? "" : "s"} written to ${folder}`;
-      ctx.setText(recording ? n : `stopped (${n})`);
-    };
-    const open = () => {
-      if (opened) return;
-      opened = true;
-      channels = ctx.inputs.map((i) => ctx.openLog(folder, i.source, shapes[i.index]!));
-      noSink = channels.some((c) => c === null);
-      describe();
-    };
-    const setRecording = (on: boolean): string => {
-      recording = on;
-      describe();
-      return on ? `recording to ${folder}` : `recording stopped (${lines} lines written)`;
-    };
+    return new LoggerRun(ctx, folder, p.Recording).instance();
+  },
+});
+
+/** Each input is written to the file named after it, so no input may be listed twice. */
+function checkDistinct(inputs: readonly InputInfo[]): void {
+  const seen = new Set<string>();
+  for (const i of inputs) {
+    if (seen.has(i.source)) {
+      throw new BlockConfigError(
+        `input '${i.source}' is listed twice; each input is written to its own file ` +
+          `${i.source}.txt, so list it once`,
+      );
+    }
+    seen.add(i.source);
+  }
+}
+
+/** One Logger at run time: its log files, whether it records, and the lines written. */
+class LoggerRun {
+  private readonly shapes: Shape[];
+  /** Per input, its log file (null where the runtime has no log sink); opened at start. */
+  private channels: (LogChannel | null)[] = [];
+  private opened = false;
+  private noSink = false;
+  private lines = 0;
+  private readonly throttle = new TextThrottle();
+
+  constructor(
+    private readonly ctx: BlockContext,
+    /** The folder of the log files, ending in a separator. */
+    private readonly folder: string,
+    private recording: boolean,
+  ) {
+    this.shapes = ctx.inputs.map((i) => i.shape ?? EMPTY_SHAPE);
+  }
+
+  /** The block instance the engine drives, with its start and stop actions. */
+  instance(): BlockInstance {
     return {
-      start() {
-        open();
+      start: () => this.open(),
+      process: this.process,
+      stop: () => {
+        if (this.opened) this.describe();
       },
-      process(f, port) {
-        if (!recording || f.n === 0) return;
-        const ch = channels[port];
-        if (!ch) return;
-        ch.write(f);
-        lines += f.n;
-        if (throttle.due(f.t[f.n - 1]!)) describe();
-      },
-      stop() {
-        if (opened) describe();
-      },
-      setParam(name, value) {
-        if (name === "Recording") setRecording(value as boolean);
+      setParam: (name, value) => {
+        if (name === "Recording") this.setRecording(value as boolean);
       },
       actions: {
         start: {
           label: "Start recording",
           description: "Resume writing events to the log files",
-          run: () => setRecording(true),
+          run: () => this.setRecording(true),
         },
         stop: {
           label: "Stop recording",
           description: "Pause writing (the files stay open)",
-          run: () => setRecording(false),
+          run: () => this.setRecording(false),
         },
       },
     };
-  },
-});
+  }
+
+  /** Writes a frame to its input's file while recording (bound: the instance's `process`). */
+  private readonly process = (f: Frame, port: number): void => {
+    if (!this.recording || f.n === 0) return;
+    const ch = this.channels[port];
+    if (!ch) return;
+    ch.write(f);
+    this.lines += f.n;
+    if (this.throttle.due(f.t[f.n - 1]!)) this.describe();
+  };
+
+  /** Opens one log file per input (once). */
+  private open(): void {
+    if (this.opened) return;
+    this.opened = true;
+    this.channels = this.ctx.inputs.map((i) =>
+      this.ctx.openLog(this.folder, i.source, this.shapes[i.index]!),
+    );
+    this.noSink = this.channels.some((c) => c === null);
+    this.describe();
+  }
+
+  /** Starts or pauses the recording; says which. */
+  private setRecording(on: boolean): string {
+    this.recording = on;
+    this.describe();
+    return on ? `recording to ${this.folder}` : `recording stopped (${this.lines} lines written)`;
+  }
+
+  /** The status: lines written and where, whether stopped, or that nothing can be recorded. */
+  private describe(): void {
+    if (this.noSink) {
+      this.ctx.setText("no log sink in this runtime: nothing is recorded");
+      return;
+    }
+    const n = `${this.lines} line${this.lines === 1 ? "" : "s"} written to ${this.folder}`;
+    this.ctx.setText(this.recording ? n : `stopped (${n})`);
+  }
+}

@@ -5,10 +5,12 @@ import {
   errorMessage,
   legacyNumber,
   LegacyParamsError,
+  type BlockAction,
+  type BlockContext,
 } from "../../engine";
 import { AdaptiveFilterKernel } from "../../engine/dsp";
 import { requireDsp } from "../shared/dsp";
-import { signalInput } from "../shared/inputs";
+import { signalInput, type SignalInput } from "../shared/inputs";
 import { TextThrottle } from "../shared/text";
 
 const params = z.strictObject({
@@ -102,36 +104,11 @@ export const AdaptiveFilter = defineBlock({
     requireDsp(ctx.type);
     const sig = signalInput(ctx, 0);
     const size = sig.size;
-    const rate = ctx.desiredRate;
-    if (!(rate > 0)) {
-      throw new BlockConfigError(
-        `AdaptiveFilter needs a sampling rate for ΔT, but input '${sig.info.source}' has no ` +
-          "desired rate; set DesiredRate on this block",
-      );
-    }
+    const kernel = createKernel(size, sampleRate(ctx, sig), p);
     const current: Params = { ...p };
-    let kernel: AdaptiveFilterKernel;
-    try {
-      kernel = new AdaptiveFilterKernel({
-        channels: size,
-        sampleRate: rate,
-        g1: p.G1,
-        g2: p.G2,
-        b1: p.B1,
-        b2: p.B2,
-        order: p.Derivative,
-      });
-    } catch (e) {
-      throw new BlockConfigError(`cannot create the filter: ${errorMessage(e)}`);
-    }
     const out = ctx.output(sig.shape);
     const timed = p.UseTimestamps;
     const text = new TextThrottle(0.5);
-    const cutoffText = (): string => {
-      const parts: string[] = [];
-      for (let c = 0; c < Math.min(size, 4); c++) parts.push(kernel.cutoff(c).toPrecision(3));
-      return `F_c ${parts.join(", ")}${size > 4 ? ", …" : ""} Hz`;
-    };
     let disposed = false;
     return {
       process(f) {
@@ -143,10 +120,10 @@ export const AdaptiveFilter = defineBlock({
         if (timed) kernel.processTimed(f.v, ft, o.v, n);
         else kernel.process(f.v, o.v, n);
         out.emit(o);
-        if (text.due(ft[n - 1]!)) ctx.setText(cutoffText());
+        if (text.due(ft[n - 1]!)) ctx.setText(cutoffText(kernel, size));
       },
       stop() {
-        if (!disposed) ctx.setText(cutoffText());
+        if (!disposed) ctx.setText(cutoffText(kernel, size));
       },
       reset() {
         kernel.reset();
@@ -158,17 +135,7 @@ export const AdaptiveFilter = defineBlock({
         kernel.setGains(next.G1, next.G2, next.B1, next.B2);
         Object.assign(current, next);
       },
-      actions: {
-        cutoff: {
-          label: "Cut-off frequencies",
-          description: "The current cut-off frequency F_c of every channel, in Hz",
-          run() {
-            const parts: string[] = [];
-            for (let c = 0; c < size; c++) parts.push(`${c}: ${kernel.cutoff(c)} Hz`);
-            return parts.join("\n");
-          },
-        },
-      },
+      actions: { cutoff: cutoffAction(kernel, size) },
       dispose() {
         disposed = true;
         kernel.dispose();
@@ -176,3 +143,52 @@ export const AdaptiveFilter = defineBlock({
     };
   },
 });
+
+/** ΔT's rate: the block's desired rate, which must be known (> 0). */
+function sampleRate(ctx: BlockContext, sig: SignalInput): number {
+  const rate = ctx.desiredRate;
+  if (!(rate > 0)) {
+    throw new BlockConfigError(
+      `AdaptiveFilter needs a sampling rate for ΔT, but input '${sig.info.source}' has no ` +
+        "desired rate; set DesiredRate on this block",
+    );
+  }
+  return rate;
+}
+
+/** The filter of `channels` channels; a kernel that refuses the params is a config error. */
+function createKernel(channels: number, rate: number, p: Params): AdaptiveFilterKernel {
+  try {
+    return new AdaptiveFilterKernel({
+      channels,
+      sampleRate: rate,
+      g1: p.G1,
+      g2: p.G2,
+      b1: p.B1,
+      b2: p.B2,
+      order: p.Derivative,
+    });
+  } catch (e) {
+    throw new BlockConfigError(`cannot create the filter: ${errorMessage(e)}`);
+  }
+}
+
+/** The status: the cut-off of the first four channels. */
+function cutoffText(kernel: AdaptiveFilterKernel, size: number): string {
+  const parts: string[] = [];
+  for (let c = 0; c < Math.min(size, 4); c++) parts.push(kernel.cutoff(c).toPrecision(3));
+  return `F_c ${parts.join(", ")}${size > 4 ? ", …" : ""} Hz`;
+}
+
+/** The `cutoff` action: every channel's current cut-off, one per line. */
+function cutoffAction(kernel: AdaptiveFilterKernel, size: number): BlockAction {
+  return {
+    label: "Cut-off frequencies",
+    description: "The current cut-off frequency F_c of every channel, in Hz",
+    run() {
+      const parts: string[] = [];
+      for (let c = 0; c < size; c++) parts.push(`${c}: ${kernel.cutoff(c)} Hz`);
+      return parts.join("\n");
+    },
+  };
+}
