@@ -92,6 +92,49 @@ function closeText(code: number, reason: string): string {
   return `the connection was closed, code ${code}${why}`;
 }
 
+type RosTransport = InstanceType<RoslibModule["AbstractTransport"]>;
+type RosTransportClass = new (ws: WebSocket) => RosTransport;
+
+/**
+ * roslib's transport on a `ws` socket (like its WsWebSocketTransport, which it does not export),
+ * as a subclass of the loaded roslib's AbstractTransport; its `close` calls `shut`.
+ */
+function wsTransportClass(lib: RoslibModule, shut: (ws: WebSocket) => void): RosTransportClass {
+  return class WsTransport extends lib.AbstractTransport {
+    constructor(private readonly ws: WebSocket) {
+      super();
+      ws.on("open", () => this.emit("open", undefined));
+      ws.on("close", (code, reason) => this.emit("close", { code, reason: reason.toString() }));
+      ws.on("error", (err) => this.emit("error", err));
+      ws.on("message", (data, isBinary) => {
+        if (!isBinary) this.handleRawMessage(data.toString());
+        else {
+          const b = Array.isArray(data) ? Buffer.concat(data) : Buffer.from(data as Buffer);
+          this.handleRawMessage(b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength));
+        }
+      });
+    }
+    send(message: object): void {
+      this.ws.send(JSON.stringify(message));
+    }
+    close(): void {
+      shut(this.ws);
+    }
+    isConnecting(): boolean {
+      return this.ws.readyState === this.ws.CONNECTING;
+    }
+    isOpen(): boolean {
+      return this.ws.readyState === this.ws.OPEN;
+    }
+    isClosing(): boolean {
+      return this.ws.readyState === this.ws.CLOSING;
+    }
+    isClosed(): boolean {
+      return this.ws.readyState === this.ws.CLOSED;
+    }
+  };
+}
+
 class RoslibConnection implements RosConnection {
   private socket: WebSocket | undefined;
   private ros: RosInstance | undefined;
@@ -100,6 +143,8 @@ class RoslibConnection implements RosConnection {
   private ended = false;
   private open = false;
   private lastError = "";
+  /** Whether a pong came since the last ping. */
+  private alive = true;
   private pinger: ReturnType<typeof setInterval> | undefined;
   /** Topics wait here while roslib loads. */
   private readonly pending: ((lib: RoslibModule, ros: RosInstance) => void)[] = [];
@@ -112,92 +157,71 @@ class RoslibConnection implements RosConnection {
     );
   }
 
+  /** Builds roslib's `Ros` on our transport, follows its events and connects. */
   private start(lib: RoslibModule, WebSocket: WsClass): void {
     if (this.closed || this.ended) return;
     const url = this.o.url;
-    const self = this;
-
-    /** roslib's transport on a `ws` socket (like its WsWebSocketTransport, which it does not export). */
-    class WsTransport extends lib.AbstractTransport {
-      constructor(private readonly ws: WebSocket) {
-        super();
-        ws.on("open", () => this.emit("open", undefined));
-        ws.on("close", (code, reason) => this.emit("close", { code, reason: reason.toString() }));
-        ws.on("error", (err) => this.emit("error", err));
-        ws.on("message", (data, isBinary) => {
-          if (!isBinary) this.handleRawMessage(data.toString());
-          else {
-            const b = Array.isArray(data) ? Buffer.concat(data) : Buffer.from(data as Buffer);
-            this.handleRawMessage(b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength));
-          }
-        });
-      }
-      send(message: object): void {
-        this.ws.send(JSON.stringify(message));
-      }
-      close(): void {
-        self.shut(this.ws);
-      }
-      isConnecting(): boolean {
-        return this.ws.readyState === this.ws.CONNECTING;
-      }
-      isOpen(): boolean {
-        return this.ws.readyState === this.ws.OPEN;
-      }
-      isClosing(): boolean {
-        return this.ws.readyState === this.ws.CLOSING;
-      }
-      isClosed(): boolean {
-        return this.ws.readyState === this.ws.CLOSED;
-      }
-    }
-
+    const Transport = wsTransportClass(lib, (ws) => this.shut(ws));
     const ros = new lib.Ros({
-      transportFactory: (u: string) => {
-        const ws = new WebSocket(u, { handshakeTimeout: HANDSHAKE_MS });
-        this.socket = ws;
-        ws.on("unexpected-response", (_req: ClientRequest, res: IncomingMessage) => {
-          this.lastError = `${u} answered HTTP ${res.statusCode ?? "?"} ${res.statusMessage ?? ""}, not a WebSocket: is this a rosbridge server?`;
-          ws.terminate();
-        });
-        ws.on("pong", () => (this.alive = true));
-        const transport = new WsTransport(ws);
-        // Every `status` op, whatever its id (roslib routes them by the id of the op they
-        // concern, e.g. one per published message).
-        transport.on("message", (m: { op?: unknown }) => {
-          if (m.op === "status") this.notice(m);
-        });
-        return Promise.resolve(transport);
-      },
+      transportFactory: (u: string) => Promise.resolve(this.transport(u, WebSocket, Transport)),
     });
     this.ros = ros;
     this.lib = lib;
-    ros.on("connection", () => {
-      if (this.closed || this.ended) return;
-      this.open = true;
-      this.alive = true;
-      this.pinger = setInterval(() => this.ping(), PING_MS);
-      this.pinger.unref?.();
-      this.o.onState("connected");
-    });
-    ros.on("error", (e: unknown) => {
-      this.lastError = describeRosError(e, url);
-      if (this.open && !this.closed) this.o.onNotice?.(this.lastError);
-    });
-    ros.on("close", (e: unknown) => {
-      const ev = e as { code?: number; reason?: string } | undefined;
-      const how =
-        this.lastError !== ""
-          ? this.lastError
-          : closeText(ev?.code ?? 1006, typeof ev?.reason === "string" ? ev.reason : "");
-      this.end(this.open ? `connection lost: ${how}` : how);
-    });
+    ros.on("connection", () => this.onConnection());
+    ros.on("error", (e: unknown) => this.onError(e));
+    ros.on("close", (e: unknown) => this.onClose(e));
     ros.connect(url).catch((e: unknown) => this.end(describeRosError(e, url)));
     for (const f of this.pending.splice(0)) f(lib, ros);
   }
 
-  private alive = true;
+  /**
+   * The transport roslib asks for: a socket to `u` whose HTTP answers (not a WebSocket) and
+   * pongs are noted, and whose `status` ops become notices.
+   */
+  private transport(u: string, WebSocket: WsClass, Transport: RosTransportClass): RosTransport {
+    const ws = new WebSocket(u, { handshakeTimeout: HANDSHAKE_MS });
+    this.socket = ws;
+    ws.on("unexpected-response", (_req: ClientRequest, res: IncomingMessage) => {
+      this.lastError = `${u} answered HTTP ${res.statusCode ?? "?"} ${res.statusMessage ?? ""}, not a WebSocket: is this a rosbridge server?`;
+      ws.terminate();
+    });
+    ws.on("pong", () => (this.alive = true));
+    const transport = new Transport(ws);
+    // Every `status` op, whatever its id (roslib routes them by the id of the op they
+    // concern, e.g. one per published message).
+    transport.on("message", (m: { op?: unknown }) => {
+      if (m.op === "status") this.notice(m);
+    });
+    return transport;
+  }
 
+  /** roslib connected: reports `connected` and starts pinging. */
+  private onConnection(): void {
+    if (this.closed || this.ended) return;
+    this.open = true;
+    this.alive = true;
+    this.pinger = setInterval(() => this.ping(), PING_MS);
+    this.pinger.unref?.();
+    this.o.onState("connected");
+  }
+
+  /** A socket error: kept for the `disconnected` message, and a notice while connected. */
+  private onError(e: unknown): void {
+    this.lastError = describeRosError(e, this.o.url);
+    if (this.open && !this.closed) this.o.onNotice?.(this.lastError);
+  }
+
+  /** The socket closed: ends the connection with the last error, else the close code. */
+  private onClose(e: unknown): void {
+    const ev = e as { code?: number; reason?: string } | undefined;
+    const how =
+      this.lastError !== ""
+        ? this.lastError
+        : closeText(ev?.code ?? 1006, typeof ev?.reason === "string" ? ev.reason : "");
+    this.end(this.open ? `connection lost: ${how}` : how);
+  }
+
+  /** Pings the open socket; a ping still unanswered at the next one ends the connection. */
   private ping(): void {
     const ws = this.socket;
     if (!ws || ws.readyState !== ws.OPEN) return;

@@ -6,7 +6,7 @@
  */
 import { existsSync, readdirSync } from "node:fs";
 import { createRequire } from "node:module";
-import type { SerialBridge, SerialHandle, SerialOptions, SerialStatus } from "../app/engine/io";
+import type { SerialBridge, SerialHandle } from "../app/engine/io";
 
 /** The part of serialport's `SerialPort` class this bridge uses. */
 interface NativePort {
@@ -21,6 +21,9 @@ interface NativePort {
   readonly isOpen: boolean;
 }
 
+/** A port as constructed, before it is opened. */
+type OpenablePort = NativePort & { open(cb: (err: Error | null) => void): void };
+
 type PortConstructor = new (options: {
   path: string;
   baudRate: number;
@@ -28,7 +31,7 @@ type PortConstructor = new (options: {
   stopBits: 1 | 1.5 | 2;
   parity: string;
   autoOpen: boolean;
-}) => NativePort & { open(cb: (err: Error | null) => void): void };
+}) => OpenablePort;
 
 let loaded: { ctor: PortConstructor } | { error: string } | undefined;
 
@@ -115,96 +118,132 @@ function drainThenClose(p: NativePort): Promise<void> {
   });
 }
 
-function openPort(
-  o: SerialOptions & {
-    reconnectMs: number;
-    onData: (data: Uint8Array) => void;
-    onStatus: (status: SerialStatus, message?: string) => void;
-  },
-  injected?: PortConstructor,
-): SerialHandle {
-  let closed = false;
-  let port: (NativePort & { open(cb: (err: Error | null) => void): void }) | undefined;
-  let retry: ReturnType<typeof setTimeout> | undefined;
-  let whenClosed: Promise<void> = Promise.resolve();
+/** What `SerialBridge.open` is given: the port's settings and where to report. */
+type PortOptions = Parameters<SerialBridge["open"]>[0];
 
-  const scheduleRetry = (reason: string): void => {
-    port = undefined;
-    if (closed) return;
+function openPort(o: PortOptions, injected?: PortConstructor): SerialHandle {
+  const kept = new KeptPort(o, injected);
+  kept.attempt();
+  return {
+    write: (data) => kept.write(data),
+    close: () => kept.close(),
+    closed: () => kept.whenClosed,
+  };
+}
+
+/**
+ * One port kept open until `close`: each attempt constructs and opens a fresh native port; a
+ * failure or an unplug schedules the next attempt. Events of a port that is no longer the
+ * current one (replaced, or closed by us) are ignored.
+ */
+class KeptPort {
+  private closed = false;
+  private port: OpenablePort | undefined;
+  private retry: ReturnType<typeof setTimeout> | undefined;
+  /** Resolves when the port closed by `close` has drained and closed. */
+  whenClosed: Promise<void> = Promise.resolve();
+
+  constructor(
+    private readonly o: PortOptions,
+    private readonly injected: PortConstructor | undefined,
+  ) {}
+
+  /** One try at opening the port: reports `opening`, then `open` or an error (and a retry). */
+  attempt(): void {
+    this.retry = undefined;
+    if (this.closed) return;
+    const lib = this.injected ? { ctor: this.injected } : load();
+    if ("error" in lib) {
+      this.o.onStatus("error", lib.error);
+      return;
+    }
+    this.o.onStatus("opening");
+    let p: OpenablePort;
+    try {
+      p = this.construct(lib.ctor);
+    } catch (e) {
+      this.scheduleRetry(describe(e as Error));
+      return;
+    }
+    this.port = p;
+    this.listen(p);
+    p.open((err) => this.opened(p, err));
+  }
+
+  private construct(ctor: PortConstructor): OpenablePort {
+    const o = this.o;
+    return new ctor({
+      path: o.path,
+      baudRate: o.baudRate,
+      dataBits: o.dataBits,
+      stopBits: o.stopBits,
+      parity: o.parity,
+      autoOpen: false,
+    });
+  }
+
+  /** Whether `p` is the port in use (not replaced, not closed by `close`). */
+  private isCurrent(p: NativePort): boolean {
+    return !this.closed && this.port === p;
+  }
+
+  /** Passes on `p`'s data and errors, and retries when the device closes it. */
+  private listen(p: OpenablePort): void {
+    p.on("data", (d) => {
+      if (this.isCurrent(p)) this.o.onData(new Uint8Array(d.buffer, d.byteOffset, d.byteLength));
+    });
+    p.on("error", (e) => {
+      if (this.isCurrent(p)) this.o.onStatus("error", describe(e));
+    });
+    p.on("close", (e) => {
+      if (!this.isCurrent(p)) return;
+      this.scheduleRetry(e?.disconnected ? "disconnected (unplugged?)" : "closed by the device");
+    });
+  }
+
+  /** The end of `p.open`: closes a port opened after `close`, else reports the outcome. */
+  private opened(p: OpenablePort, err: Error | null): void {
+    if (this.closed) {
+      if (!err) p.close();
+      return;
+    }
+    if (err) this.scheduleRetry(describe(err));
+    else this.o.onStatus("open");
+  }
+
+  /** Forgets the port, reports `reason` and, unless `reconnectMs` is 0, tries again then. */
+  private scheduleRetry(reason: string): void {
+    this.port = undefined;
+    if (this.closed) return;
+    const o = this.o;
     if (o.reconnectMs > 0) {
       o.onStatus("error", `${reason}; retrying every ${formatSeconds(o.reconnectMs)}`);
-      retry = setTimeout(attempt, o.reconnectMs);
-      retry.unref?.();
+      this.retry = setTimeout(() => this.attempt(), o.reconnectMs);
+      this.retry.unref?.();
     } else {
       o.onStatus("error", reason);
     }
-  };
+  }
 
-  const attempt = (): void => {
-    retry = undefined;
-    if (closed) return;
-    const lib = injected ? { ctor: injected } : load();
-    if ("error" in lib) {
-      o.onStatus("error", lib.error);
-      return;
-    }
-    o.onStatus("opening");
-    let p: NativePort & { open(cb: (err: Error | null) => void): void };
-    try {
-      p = new lib.ctor({
-        path: o.path,
-        baudRate: o.baudRate,
-        dataBits: o.dataBits,
-        stopBits: o.stopBits,
-        parity: o.parity,
-        autoOpen: false,
-      });
-    } catch (e) {
-      scheduleRetry(describe(e as Error));
-      return;
-    }
-    port = p;
-    p.on("data", (d) => {
-      if (!closed && port === p) o.onData(new Uint8Array(d.buffer, d.byteOffset, d.byteLength));
+  /** Writes to the open port (dropped while none is open); a failed write is reported. */
+  write(data: Uint8Array): void {
+    const p = this.port;
+    if (!p || !p.isOpen) return;
+    p.write(data, (err) => {
+      if (err && this.isCurrent(p)) this.o.onStatus("error", `write failed: ${describe(err)}`);
     });
-    p.on("error", (e) => {
-      if (!closed && port === p) o.onStatus("error", describe(e));
-    });
-    p.on("close", (e) => {
-      if (closed || port !== p) return;
-      scheduleRetry(e?.disconnected ? "disconnected (unplugged?)" : "closed by the device");
-    });
-    p.open((err) => {
-      if (closed) {
-        if (!err) p.close();
-        return;
-      }
-      if (err) scheduleRetry(describe(err));
-      else o.onStatus("open");
-    });
-  };
+  }
 
-  attempt();
-
-  return {
-    write(data) {
-      const p = port;
-      if (!p || !p.isOpen) return;
-      p.write(data, (err) => {
-        if (err && !closed && port === p) o.onStatus("error", `write failed: ${describe(err)}`);
-      });
-    },
-    close() {
-      if (closed) return;
-      closed = true;
-      if (retry) clearTimeout(retry);
-      const p = port;
-      port = undefined;
-      if (p?.isOpen) whenClosed = drainThenClose(p);
-      o.onStatus("closed");
-    },
-    closed: () => whenClosed,
-  };
+  /** Stops retrying and closes the port once its pending writes are out. */
+  close(): void {
+    if (this.closed) return;
+    this.closed = true;
+    if (this.retry) clearTimeout(this.retry);
+    const p = this.port;
+    this.port = undefined;
+    if (p?.isOpen) this.whenClosed = drainThenClose(p);
+    this.o.onStatus("closed");
+  }
 }
 
 function formatSeconds(ms: number): string {
