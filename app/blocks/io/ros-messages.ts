@@ -110,6 +110,7 @@ function readFields(msg: unknown, keys: readonly string[], out: Float64Array): s
   return undefined;
 }
 
+const FLOAT64 = ["data"] as const;
 const VECTOR3 = ["x", "y", "z"] as const;
 const TWIST = ["linear.x", "linear.y", "linear.z", "angular.x", "angular.y", "angular.z"] as const;
 
@@ -128,68 +129,86 @@ function multiArrayLayout(o: RosCodecOptions): object {
 }
 
 export function rosEncoder(type: RosMessageType, o: RosCodecOptions): RosEncoder {
-  const size = o.size;
   switch (type) {
     case "std_msgs/Float64MultiArray":
-    case "std_msgs/Float32MultiArray": {
-      const f32 = type === "std_msgs/Float32MultiArray";
-      const data = new Array<number>(size).fill(0);
-      const msg = { layout: multiArrayLayout(o), data };
-      return {
-        encode(v, off) {
-          for (let i = 0; i < size; i++) data[i] = f32 ? Math.fround(v[off + i]!) : v[off + i]!;
-          return msg;
-        },
-      };
-    }
-    case "std_msgs/Float64": {
-      const msg = { data: 0 };
-      return {
-        encode(v, off) {
-          msg.data = v[off]!;
-          return msg;
-        },
-      };
-    }
-    case "geometry_msgs/Vector3": {
-      const msg = { x: 0, y: 0, z: 0 };
-      return {
-        encode(v, off) {
-          msg.x = v[off]!;
-          msg.y = v[off + 1]!;
-          msg.z = v[off + 2]!;
-          return msg;
-        },
-      };
-    }
-    case "geometry_msgs/Twist": {
-      const linear = { x: 0, y: 0, z: 0 };
-      const angular = { x: 0, y: 0, z: 0 };
-      const msg = { linear, angular };
-      return {
-        encode(v, off) {
-          linear.x = v[off]!;
-          linear.y = v[off + 1]!;
-          linear.z = v[off + 2]!;
-          angular.x = v[off + 3]!;
-          angular.y = v[off + 4]!;
-          angular.z = v[off + 5]!;
-          return msg;
-        },
-      };
-    }
-    case "sensor_msgs/JointState": {
-      // No header: rosbridge fills it in (frame_id "", stamp = the time it publishes).
-      const position = new Array<number>(size).fill(0);
-      const msg = { name: [...(o.jointNames ?? [])], position, velocity: [], effort: [] };
-      return {
-        encode(v, off) {
-          for (let i = 0; i < size; i++) position[i] = v[off + i]!;
-          return msg;
-        },
-      };
-    }
+      return multiArrayEncoder(o, false);
+    case "std_msgs/Float32MultiArray":
+      return multiArrayEncoder(o, true);
+    case "std_msgs/Float64":
+      return float64Encoder();
+    case "geometry_msgs/Vector3":
+      return vector3Encoder();
+    case "geometry_msgs/Twist":
+      return twistEncoder();
+    case "sensor_msgs/JointState":
+      return jointStateEncoder(o);
   }
+}
+
+/** Float64MultiArray, or Float32MultiArray (`f32`: the values rounded to float32). */
+function multiArrayEncoder(o: RosCodecOptions, f32: boolean): RosEncoder {
+  const size = o.size;
+  const data = new Array<number>(size).fill(0);
+  const msg = { layout: multiArrayLayout(o), data };
+  return {
+    encode(v, off) {
+      for (let i = 0; i < size; i++) data[i] = f32 ? Math.fround(v[off + i]!) : v[off + i]!;
+      return msg;
+    },
+  };
+}
+
+function float64Encoder(): RosEncoder {
+  const msg = { data: 0 };
+  return {
+    encode(v, off) {
+      msg.data = v[off]!;
+      return msg;
+    },
+  };
+}
+
+function vector3Encoder(): RosEncoder {
+  const msg = { x: 0, y: 0, z: 0 };
+  return {
+    encode(v, off) {
+      msg.x = v[off]!;
+      msg.y = v[off + 1]!;
+      msg.z = v[off + 2]!;
+      return msg;
+    },
+  };
+}
+
+function twistEncoder(): RosEncoder {
+  const linear = { x: 0, y: 0, z: 0 };
+  const angular = { x: 0, y: 0, z: 0 };
+  const msg = { linear, angular };
+  return {
+    encode(v, off) {
+      linear.x = v[off]!;
+      linear.y = v[off + 1]!;
+      linear.z = v[off + 2]!;
+      angular.x = v[off + 3]!;
+      angular.y = v[off + 4]!;
+      angular.z = v[off + 5]!;
+      return msg;
+    },
+  };
+}
+
+/** JointState: the joints' names (as given) and their positions. */
+function jointStateEncoder(o: RosCodecOptions): RosEncoder {
+  const size = o.size;
+  // No header: rosbridge fills it in (frame_id "", stamp = the time it publishes).
+  const position = new Array<number>(size).fill(0);
+  const msg = { name: [...(o.jointNames ?? [])], position, velocity: [], effort: [] };
+  return {
+    encode(v, off) {
+      for (let i = 0; i < size; i++) position[i] = v[off + i]!;
+      return msg;
+    },
+  };
 }
 
 export function rosDecoder(type: RosMessageType, o: RosCodecOptions): RosDecoder {
@@ -197,73 +216,103 @@ export function rosDecoder(type: RosMessageType, o: RosCodecOptions): RosDecoder
   switch (type) {
     case "std_msgs/Float64MultiArray":
     case "std_msgs/Float32MultiArray":
-      return {
-        decode(msg, out) {
-          if (!isObj(msg)) return "not a message object";
-          const data = msg.data;
-          if (!isList(data)) return data === undefined ? "no data" : "data is not a list";
-          let offset = 0;
-          const layout = msg.layout;
-          if (isObj(layout) && layout.data_offset !== undefined) {
-            const d = layout.data_offset;
-            if (typeof d !== "number" || !Number.isInteger(d) || d < 0 || d > data.length) {
-              return `layout.data_offset ${JSON.stringify(d)} does not fit ${data.length} values`;
-            }
-            offset = d;
-          }
-          const n = data.length - offset;
-          if (n !== size) return expected(n, size);
-          return copyNumbers(data, offset, n, out, "data");
-        },
-      };
+      return { decode: (msg, out) => decodeMultiArray(msg, size, out) };
     case "std_msgs/Float64":
-      return { decode: (msg, out) => readFields(msg, ["data"], out) };
+      return { decode: (msg, out) => readFields(msg, FLOAT64, out) };
     case "geometry_msgs/Vector3":
       return { decode: (msg, out) => readFields(msg, VECTOR3, out) };
     case "geometry_msgs/Twist":
       return { decode: (msg, out) => readFields(msg, TWIST, out) };
-    case "sensor_msgs/JointState": {
-      const names = o.jointNames;
-      // The order of `name` seldom changes: the index of each wanted joint is kept until it does.
-      let lastNames: string[] = [];
-      let index: number[] = [];
-      return {
-        decode(msg, out) {
-          if (!isObj(msg)) return "not a message object";
-          const position = msg.position;
-          if (!isList(position)) {
-            return position === undefined ? "no position" : "position is not a list";
-          }
-          if (!names) {
-            if (position.length !== size) return expected(position.length, size);
-            return copyNumbers(position, 0, size, out, "position");
-          }
-          const got = msg.name;
-          if (!Array.isArray(got)) return "no name list to find the joints in";
-          if (got.length !== lastNames.length || got.some((g, i) => g !== lastNames[i])) {
-            const at = new Map<unknown, number>();
-            got.forEach((g, i) => {
-              if (!at.has(g)) at.set(g, i);
-            });
-            const missing = names.filter((n) => !at.has(n));
-            if (missing.length > 0) {
-              return `no joint ${missing.map((m) => `'${m}'`).join(", ")} in name`;
-            }
-            lastNames = got.map(String);
-            index = names.map((n) => at.get(n)!);
-          }
-          for (let i = 0; i < size; i++) {
-            const k = index[i]!;
-            if (k >= position.length) {
-              return `position has ${position.length} values, joint '${names[i]}' is number ${k + 1} in name`;
-            }
-            const x = num(position[k]);
-            if (x === undefined) return `position[${k}] is not a number`;
-            out[i] = x;
-          }
-          return undefined;
-        },
-      };
+    case "sensor_msgs/JointState":
+      return new JointStateDecoder(size, o.jointNames);
+  }
+}
+
+/** A MultiArray's `size` values: `data` after `layout.data_offset`. */
+function decodeMultiArray(msg: unknown, size: number, out: Float64Array): string | undefined {
+  if (!isObj(msg)) return "not a message object";
+  const data = msg.data;
+  if (!isList(data)) return data === undefined ? "no data" : "data is not a list";
+  const offset = dataOffset(msg.layout, data.length);
+  if (typeof offset === "string") return offset;
+  const n = data.length - offset;
+  if (n !== size) return expected(n, size);
+  return copyNumbers(data, offset, n, out, "data");
+}
+
+/** Where the values start in `data` (`layout.data_offset`, else 0), or why it does not fit. */
+function dataOffset(layout: unknown, length: number): number | string {
+  if (!isObj(layout) || layout.data_offset === undefined) return 0;
+  const d = layout.data_offset;
+  if (typeof d !== "number" || !Number.isInteger(d) || d < 0 || d > length) {
+    return `layout.data_offset ${JSON.stringify(d)} does not fit ${length} values`;
+  }
+  return d;
+}
+
+/** JointState: `position`, in order, or the positions of the named joints found in `name`. */
+class JointStateDecoder implements RosDecoder {
+  // The order of `name` seldom changes: the index of each wanted joint is kept until it does.
+  private lastNames: string[] = [];
+  /** Where each wanted joint is in `name` (and so in `position`). */
+  private index: number[] = [];
+
+  constructor(
+    private readonly size: number,
+    private readonly names: readonly string[] | undefined,
+  ) {}
+
+  decode(msg: unknown, out: Float64Array): string | undefined {
+    if (!isObj(msg)) return "not a message object";
+    const position = msg.position;
+    if (!isList(position)) {
+      return position === undefined ? "no position" : "position is not a list";
     }
+    const { size, names } = this;
+    if (!names) {
+      if (position.length !== size) return expected(position.length, size);
+      return copyNumbers(position, 0, size, out, "position");
+    }
+    const got = msg.name;
+    if (!Array.isArray(got)) return "no name list to find the joints in";
+    if (got.length !== this.lastNames.length || got.some((g, i) => g !== this.lastNames[i])) {
+      const missing = this.findJoints(got, names);
+      if (missing !== undefined) return missing;
+    }
+    return this.readJoints(position, names, out);
+  }
+
+  /** Finds each wanted joint in the new name list `got`; says which are missing. */
+  private findJoints(got: unknown[], names: readonly string[]): string | undefined {
+    const at = new Map<unknown, number>();
+    got.forEach((g, i) => {
+      if (!at.has(g)) at.set(g, i);
+    });
+    const missing = names.filter((n) => !at.has(n));
+    if (missing.length > 0) {
+      return `no joint ${missing.map((m) => `'${m}'`).join(", ")} in name`;
+    }
+    this.lastNames = got.map(String);
+    this.index = names.map((n) => at.get(n)!);
+    return undefined;
+  }
+
+  /** Copies the wanted joints' positions into `out`, or says which is missing or not a number. */
+  private readJoints(
+    position: ArrayLike<unknown>,
+    names: readonly string[],
+    out: Float64Array,
+  ): string | undefined {
+    const index = this.index;
+    for (let i = 0; i < this.size; i++) {
+      const k = index[i]!;
+      if (k >= position.length) {
+        return `position has ${position.length} values, joint '${names[i]}' is number ${k + 1} in name`;
+      }
+      const x = num(position[k]);
+      if (x === undefined) return `position[${k}] is not a number`;
+      out[i] = x;
+    }
+    return undefined;
   }
 }

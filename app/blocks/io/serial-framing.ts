@@ -66,81 +66,113 @@ const DEFAULT_SEPARATOR = /[,;\s]+/;
 
 /** One vector per line: `1.5,2,-3` (or separated by `;`, tabs, spaces), `\n` or `\r\n` ended. */
 export function lineDecoder(options: LineOptions): Decoder {
-  const { channels } = options;
-  const sep = options.separator ?? DEFAULT_SEPARATOR;
-  const maxLine = options.maxLineBytes ?? 4096;
-  const out = new Float64Array(channels);
-  let pending = new Uint8Array(256);
-  let used = 0;
-  let overflow = false;
-  const stats = newStats();
+  return new LineDecoder(options);
+}
 
-  const line = (bytes: Uint8Array, frame: (v: Float64Array) => void): void => {
-    const text = latin1(bytes).trim();
-    if (text === "") return;
-    const parts = text.split(sep);
-    if (parts.length !== channels) {
-      stats.malformed++;
-      stats.lastProblem = `a line with ${parts.length} value${parts.length === 1 ? "" : "s"} (expected ${channels}): "${clip(text)}"`;
+/** The line decoder: the start of a line split across chunks is kept until its end arrives. */
+class LineDecoder implements Decoder {
+  readonly stats = newStats();
+  private readonly channels: number;
+  private readonly sep: RegExp;
+  private readonly maxLine: number;
+  /** The vector handed to `frame` (reused). */
+  private readonly out: Float64Array;
+  /** The line carried over from earlier chunks: `pending[0, used)`. */
+  private pending = new Uint8Array(256);
+  private used = 0;
+  /** The carried line is already longer than `maxLine`: it is dropped when it ends. */
+  private overflow = false;
+
+  constructor(options: LineOptions) {
+    this.channels = options.channels;
+    this.sep = options.separator ?? DEFAULT_SEPARATOR;
+    this.maxLine = options.maxLineBytes ?? 4096;
+    this.out = new Float64Array(options.channels);
+  }
+
+  reset(): void {
+    this.used = 0;
+    this.overflow = false;
+  }
+
+  push(bytes: Uint8Array, frame: (values: Float64Array) => void): void {
+    let start = 0;
+    for (let i = 0; i < bytes.length; i++) {
+      if (bytes[i] !== 0x0a) continue;
+      const piece = bytes.subarray(start, i);
+      start = i + 1;
+      this.endLine(piece, frame);
+    }
+    this.carry(bytes.subarray(start));
+  }
+
+  /** A line ends with `piece` (after what was carried): decodes it, or drops it when too long. */
+  private endLine(piece: Uint8Array, frame: (values: Float64Array) => void): void {
+    if (this.overflow || this.used + piece.length > this.maxLine) {
+      this.stats.malformed++;
+      this.stats.lastProblem = `a line longer than ${this.maxLine} bytes`;
+      this.used = 0;
+      this.overflow = false;
       return;
     }
-    for (let i = 0; i < channels; i++) {
+    if (this.used > 0) {
+      this.append(piece);
+      this.decodeLine(this.pending.subarray(0, this.used), frame);
+      this.used = 0;
+    } else {
+      this.decodeLine(piece, frame);
+    }
+  }
+
+  /** Keeps the unfinished line at the end of a chunk (or notes that it is too long). */
+  private carry(rest: Uint8Array): void {
+    if (rest.length === 0) return;
+    if (this.overflow || this.used + rest.length > this.maxLine) this.overflow = true;
+    else this.append(rest);
+  }
+
+  /** Decodes one whole line (blank lines are skipped); counts it when it is malformed. */
+  private decodeLine(bytes: Uint8Array, frame: (values: Float64Array) => void): void {
+    const text = latin1(bytes).trim();
+    if (text === "") return;
+    const parts = text.split(this.sep);
+    const channels = this.channels;
+    if (parts.length !== channels) {
+      this.stats.malformed++;
+      this.stats.lastProblem = `a line with ${parts.length} value${parts.length === 1 ? "" : "s"} (expected ${channels}): "${clip(text)}"`;
+      return;
+    }
+    if (!this.readNumbers(parts, text)) return;
+    this.stats.frames++;
+    frame(this.out);
+  }
+
+  /** Parses the line's `parts` into `out`; false (counted) when one is not a number. */
+  private readNumbers(parts: readonly string[], text: string): boolean {
+    const out = this.out;
+    for (let i = 0; i < this.channels; i++) {
       const s = parts[i]!;
       const v = Number(s);
       if (s === "" || !Number.isFinite(v)) {
-        stats.malformed++;
-        stats.lastProblem = `"${clip(s)}" is not a number in the line "${clip(text)}"`;
-        return;
+        this.stats.malformed++;
+        this.stats.lastProblem = `"${clip(s)}" is not a number in the line "${clip(text)}"`;
+        return false;
       }
       out[i] = v;
     }
-    stats.frames++;
-    frame(out);
-  };
+    return true;
+  }
 
-  return {
-    stats,
-    reset() {
-      used = 0;
-      overflow = false;
-    },
-    push(bytes, frame) {
-      let start = 0;
-      for (let i = 0; i < bytes.length; i++) {
-        if (bytes[i] !== 0x0a) continue;
-        const piece = bytes.subarray(start, i);
-        start = i + 1;
-        if (overflow || used + piece.length > maxLine) {
-          stats.malformed++;
-          stats.lastProblem = `a line longer than ${maxLine} bytes`;
-          used = 0;
-          overflow = false;
-          continue;
-        }
-        if (used > 0) {
-          append(piece);
-          line(pending.subarray(0, used), frame);
-          used = 0;
-        } else {
-          line(piece, frame);
-        }
-      }
-      const rest = bytes.subarray(start);
-      if (rest.length > 0) {
-        if (overflow || used + rest.length > maxLine) overflow = true;
-        else append(rest);
-      }
-    },
-  };
-
-  function append(piece: Uint8Array): void {
-    if (used + piece.length > pending.length) {
-      const bigger = new Uint8Array(Math.max(pending.length * 2, used + piece.length));
-      bigger.set(pending.subarray(0, used));
-      pending = bigger;
+  /** Appends `piece` to the carried line, growing its buffer when needed. */
+  private append(piece: Uint8Array): void {
+    const used = this.used;
+    if (used + piece.length > this.pending.length) {
+      const bigger = new Uint8Array(Math.max(this.pending.length * 2, used + piece.length));
+      bigger.set(this.pending.subarray(0, used));
+      this.pending = bigger;
     }
-    pending.set(piece, used);
-    used += piece.length;
+    this.pending.set(piece, used);
+    this.used = used + piece.length;
   }
 }
 
@@ -275,65 +307,103 @@ function writeField(view: DataView, offset: number, type: FieldType, v: number, 
  * frame.
  */
 export function structDecoder(o: StructOptions): Decoder {
-  const size = structSize(o);
-  const payload = payloadSize(o.fields);
-  const csSize = CHECKSUM_SIZE[o.checksum];
-  const out = new Float64Array(o.fields.length);
-  const buf = new Uint8Array(Math.max(size * 64, 1024));
-  const view = new DataView(buf.buffer);
-  let used = 0;
-  const stats = newStats();
+  return new StructDecoder(o);
+}
 
-  const syncAt = (i: number): boolean => {
-    for (let k = 0; k < o.sync.length; k++) if (buf[i + k] !== o.sync[k]) return false;
-    return true;
-  };
+/** The struct decoder: received bytes wait in a fixed buffer until they make a whole frame. */
+class StructDecoder implements Decoder {
+  readonly stats = newStats();
+  /** Bytes per frame: sync + payload + checksum. */
+  private readonly size: number;
+  /** Bytes of the fields. */
+  private readonly payload: number;
+  private readonly csSize: number;
+  /** The vector handed to `frame` (reused). */
+  private readonly out: Float64Array;
+  /** Bytes received and not yet decoded: `buf[0, used)`. */
+  private readonly buf: Uint8Array;
+  private readonly view: DataView;
+  private used = 0;
 
-  return {
-    stats,
-    reset() {
-      used = 0;
-    },
-    push(bytes, frame) {
-      let offset = 0;
-      while (offset < bytes.length) {
-        const n = Math.min(bytes.length - offset, buf.length - used);
-        buf.set(bytes.subarray(offset, offset + n), used);
-        used += n;
-        offset += n;
-        let i = 0;
-        while (used - i >= size) {
-          if (!syncAt(i)) {
-            i++;
-            stats.skipped++;
-            continue;
-          }
-          const p = i + o.sync.length;
-          if (csSize > 0) {
-            const want = checksumOf(o.checksum, buf.subarray(p, p + payload));
-            const got =
-              csSize === 1 ? buf[p + payload]! : view.getUint16(p + payload, o.littleEndian);
-            if (want !== got) {
-              stats.malformed++;
-              stats.lastProblem = `a frame with a bad ${o.checksum} checksum (0x${got.toString(16)}, computed 0x${want.toString(16)})`;
-              i++;
-              continue;
-            }
-          }
-          let q = p;
-          for (let f = 0; f < o.fields.length; f++) {
-            out[f] = readField(view, q, o.fields[f]!, o.littleEndian);
-            q += FIELD_SIZE[o.fields[f]!];
-          }
-          stats.frames++;
-          frame(out);
-          i += size;
-        }
-        buf.copyWithin(0, i, used);
-        used -= i;
+  constructor(private readonly o: StructOptions) {
+    this.size = structSize(o);
+    this.payload = payloadSize(o.fields);
+    this.csSize = CHECKSUM_SIZE[o.checksum];
+    this.out = new Float64Array(o.fields.length);
+    this.buf = new Uint8Array(Math.max(this.size * 64, 1024));
+    this.view = new DataView(this.buf.buffer);
+  }
+
+  reset(): void {
+    this.used = 0;
+  }
+
+  push(bytes: Uint8Array, frame: (values: Float64Array) => void): void {
+    const buf = this.buf;
+    let offset = 0;
+    while (offset < bytes.length) {
+      const n = Math.min(bytes.length - offset, buf.length - this.used);
+      buf.set(bytes.subarray(offset, offset + n), this.used);
+      this.used += n;
+      offset += n;
+      const i = this.decodeFrames(frame);
+      buf.copyWithin(0, i, this.used);
+      this.used -= i;
+    }
+  }
+
+  /** Decodes every whole frame in the buffer; returns how many bytes were used up (or skipped). */
+  private decodeFrames(frame: (values: Float64Array) => void): number {
+    const size = this.size;
+    const stats = this.stats;
+    let i = 0;
+    while (this.used - i >= size) {
+      if (!this.syncAt(i)) {
+        i++;
+        stats.skipped++;
+        continue;
       }
-    },
-  };
+      const p = i + this.o.sync.length;
+      if (!this.checksumMatches(p)) {
+        i++;
+        continue;
+      }
+      this.readFields(p);
+      stats.frames++;
+      frame(this.out);
+      i += size;
+    }
+    return i;
+  }
+
+  /** Whether the sync bytes are at `buf[i]`. */
+  private syncAt(i: number): boolean {
+    const sync = this.o.sync;
+    for (let k = 0; k < sync.length; k++) if (this.buf[i + k] !== sync[k]) return false;
+    return true;
+  }
+
+  /** Whether the payload at `p` matches the checksum after it (or there is none); counts a miss. */
+  private checksumMatches(p: number): boolean {
+    const { o, buf, payload, csSize } = this;
+    if (csSize === 0) return true;
+    const want = checksumOf(o.checksum, buf.subarray(p, p + payload));
+    const got = csSize === 1 ? buf[p + payload]! : this.view.getUint16(p + payload, o.littleEndian);
+    if (want === got) return true;
+    this.stats.malformed++;
+    this.stats.lastProblem = `a frame with a bad ${o.checksum} checksum (0x${got.toString(16)}, computed 0x${want.toString(16)})`;
+    return false;
+  }
+
+  /** Reads the fields of the payload at `p` into `out`. */
+  private readFields(p: number): void {
+    const { o, view, out } = this;
+    let q = p;
+    for (let f = 0; f < o.fields.length; f++) {
+      out[f] = readField(view, q, o.fields[f]!, o.littleEndian);
+      q += FIELD_SIZE[o.fields[f]!];
+    }
+  }
 }
 
 /** Writes one frame per vector (integers rounded and clamped to their type's range). */

@@ -1,5 +1,12 @@
 import { z } from "zod";
-import { defineBlock, vectorShape } from "../../engine";
+import {
+  defineBlock,
+  vectorShape,
+  type BlockContext,
+  type BlockInstance,
+  type OutputPort,
+  type TimerHandle,
+} from "../../engine";
 import { TextThrottle } from "../shared/text";
 import { InletLink } from "./inlet-link";
 import { resolveParams } from "./lsl-inlet";
@@ -47,64 +54,101 @@ export const LslMarkerInlet = defineBlock({
   create(ctx, p: Params) {
     const predicate = streamPredicate(p);
     const out = ctx.output(vectorShape(1));
-    const throttle = new TextThrottle(0.25);
-    let last = "";
-    let unmapped = 0;
-    const link = new InletLink(ctx, {
+    return new MarkerInletRun(ctx, p, predicate, out).instance();
+  },
+});
+
+/** One LslMarkerInlet at run time: its inlet, the poll timer, the last marker and the status. */
+class MarkerInletRun {
+  private readonly throttle = new TextThrottle(0.25);
+  private readonly link: InletLink;
+  private readonly timer: TimerHandle;
+  /** The last marker received, as text. */
+  private last = "";
+  /** String markers that were neither a label nor a number (emitted as NaN). */
+  private unmapped = 0;
+
+  constructor(
+    private readonly ctx: BlockContext,
+    private readonly p: Params,
+    predicate: string,
+    private readonly out: OutputPort,
+  ) {
+    this.link = new InletLink(ctx, {
       predicate,
       channels: 1,
       acceptStrings: true,
       bufferS: p.BufferSeconds,
       recover: p.Recover,
-      onSamples(n, values, strings, times) {
-        const f = out.frame(n);
-        for (let i = 0; i < n; i++) {
-          f.t[i] = times[i]!;
-          if (strings) {
-            last = strings[i]!;
-            const v = markerValue(last, p.Labels);
-            if (Number.isNaN(v)) unmapped++;
-            f.v[i] = v;
-          } else {
-            f.v[i] = values[i]!;
-            last = String(values[i]);
-          }
-        }
-        out.emit(f);
-      },
+      onSamples: this.onSamples,
     });
-    const describe = (): void => {
-      let s = link.text();
-      if (link.samples > 0) s += `, last '${last}'`;
-      if (unmapped > 0) s += `, ${unmapped} not a label or number (NaN)`;
-      ctx.setText(s);
-    };
     // Every due tick in one call (a stall is not a skipped tick: the block is not behind).
-    const timer = ctx.every(p.PollRate, (times, n) => {
-      const now = times[n - 1]!;
-      link.poll(now);
-      if (throttle.due(now)) describe();
-    });
+    this.timer = ctx.every(p.PollRate, (times, n) => this.poll(times[n - 1]!));
+  }
+
+  /** The block instance the engine drives. */
+  instance(): BlockInstance {
     return {
-      start() {
-        const lsl = lslBridge(ctx);
-        if (!lsl) return;
-        if (!link.start(lsl)) {
-          ctx.error(`LSL marker inlet: ${link.failure}`);
-          ctx.setText(link.failure);
-          return;
-        }
-        describe();
-        timer.start();
+      start: () => this.start(),
+      stop: () => {
+        this.timer.stop();
+        this.link.close();
+        this.describe();
       },
-      stop() {
-        timer.stop();
-        link.close();
-        describe();
-      },
-      dispose() {
-        link.close();
+      dispose: () => {
+        this.link.close();
       },
     };
-  },
-});
+  }
+
+  /** Starts resolving the stream and polling (or says why LSL cannot be used). */
+  private start(): void {
+    const { ctx, link } = this;
+    const lsl = lslBridge(ctx);
+    if (!lsl) return;
+    if (!link.start(lsl)) {
+      ctx.error(`LSL marker inlet: ${link.failure}`);
+      ctx.setText(link.failure);
+      return;
+    }
+    this.describe();
+    this.timer.start();
+  }
+
+  /** Emits the markers pulled as one frame of [1, 1] events (bound: the link's callback). */
+  private readonly onSamples = (
+    n: number,
+    values: Float64Array,
+    strings: readonly string[] | undefined,
+    times: Float64Array,
+  ): void => {
+    const f = this.out.frame(n);
+    for (let i = 0; i < n; i++) {
+      f.t[i] = times[i]!;
+      if (strings) {
+        this.last = strings[i]!;
+        const v = markerValue(this.last, this.p.Labels);
+        if (Number.isNaN(v)) this.unmapped++;
+        f.v[i] = v;
+      } else {
+        f.v[i] = values[i]!;
+        this.last = String(values[i]);
+      }
+    }
+    this.out.emit(f);
+  };
+
+  /** Pulls what arrived by `now` and refreshes the status now and then. */
+  private poll(now: number): void {
+    this.link.poll(now);
+    if (this.throttle.due(now)) this.describe();
+  }
+
+  /** The status: the link's, the last marker and the markers read as NaN. */
+  private describe(): void {
+    let s = this.link.text();
+    if (this.link.samples > 0) s += `, last '${this.last}'`;
+    if (this.unmapped > 0) s += `, ${this.unmapped} not a label or number (NaN)`;
+    this.ctx.setText(s);
+  }
+}

@@ -127,6 +127,21 @@ export function readLayout(line: string, lineNo: number, o: ParseOptions): Layou
   const delimiter = o.delimiter === "auto" ? detectDelimiter(firstLine) : o.delimiter;
   const firstFields = split(firstLine, delimiter);
   const width = firstFields.length;
+  checkWidth(width, lineNo, o);
+  const looksLikeHeader = firstFields.some((f) => parseField(f) === undefined);
+  const hasHeader = o.header === "auto" ? looksLikeHeader : o.header;
+  const names = hasHeader ? firstFields : firstFields.map((_, i) => String(i));
+  const head: Head = { names, hasHeader, width };
+  const timeColumn = timeColumnOf(head, o);
+  const columns = dataColumns(head, timeColumn, o);
+  return { names, hasHeader, delimiter, columns, timeColumn, width, firstLine: lineNo };
+}
+
+/** What the first line says before the columns are chosen. */
+type Head = Pick<Layout, "names" | "hasHeader" | "width">;
+
+/** A first line of more fields than a recording may have columns is refused. */
+function checkWidth(width: number, lineNo: number, o: ParseOptions): void {
   if (width > FILE_LIMITS.columns) {
     throw new BlockConfigError(
       `line ${lineNo} of '${o.file}' has ${width} fields; a recording may have at most ` +
@@ -134,62 +149,71 @@ export function readLayout(line: string, lineNo: number, o: ParseOptions): Layou
       "File",
     );
   }
-  const looksLikeHeader = firstFields.some((f) => parseField(f) === undefined);
-  const hasHeader = o.header === "auto" ? looksLikeHeader : o.header;
-  const names = hasHeader ? firstFields : firstFields.map((_, i) => String(i));
+}
 
-  const resolve = (ref: ColumnRef, param: string): number => {
-    if (typeof ref === "number") {
-      if (ref >= width) {
-        throw new BlockConfigError(
-          `column index ${ref} is out of range: '${o.file}' has ${width} column${width === 1 ? "" : "s"} ` +
-            `(valid: 0–${width - 1})`,
-          param,
-        );
-      }
-      return ref;
-    }
-    if (!hasHeader) {
-      throw new BlockConfigError(
-        `column '${ref}' is a name, but '${o.file}' has no header line; give 0-based column indices ` +
-          `(0–${width - 1}) or set Header: true`,
-        param,
-      );
-    }
-    let i = names.indexOf(ref);
-    if (i < 0) i = names.findIndex((n) => n.toLowerCase() === ref.toLowerCase());
-    if (i < 0) {
-      const s = closest(ref, names);
-      throw new BlockConfigError(
-        `'${o.file}' has no column '${ref}' (its columns: ${listNames(names)})` +
-          (s !== undefined ? `; did you mean ${quote(s)}?` : ""),
-        param,
-      );
-    }
-    return i;
-  };
-
-  let timeColumn = -1;
+/** The time column: the one given, else (no `TimeColumn`) a header named like one; -1 for none. */
+function timeColumnOf(head: Head, o: ParseOptions): number {
   if (o.timeColumn === undefined) {
-    if (hasHeader) {
-      timeColumn = names.findIndex((n) =>
-        (TIME_COLUMN_NAMES as readonly string[]).includes(n.toLowerCase()),
-      );
-    }
-  } else if (o.timeColumn !== false) {
-    timeColumn = resolve(o.timeColumn, "TimeColumn");
+    if (!head.hasHeader) return -1;
+    return head.names.findIndex((n) =>
+      (TIME_COLUMN_NAMES as readonly string[]).includes(n.toLowerCase()),
+    );
   }
+  if (o.timeColumn === false) return -1;
+  return resolveColumn(o.timeColumn, "TimeColumn", head, o);
+}
+
+/** The data columns: those given, else every column but the time column; at least one. */
+function dataColumns(head: Head, timeColumn: number, o: ParseOptions): number[] {
   const columns =
     o.columns !== undefined
-      ? o.columns.map((c) => resolve(c, "Columns"))
-      : names.map((_, i) => i).filter((i) => i !== timeColumn);
+      ? o.columns.map((c) => resolveColumn(c, "Columns", head, o))
+      : head.names.map((_, i) => i).filter((i) => i !== timeColumn);
   if (columns.length === 0) {
     throw new BlockConfigError(
-      `'${o.file}' has no data columns besides its time column ${quote(names[timeColumn]!)}`,
+      `'${o.file}' has no data columns besides its time column ${quote(head.names[timeColumn]!)}`,
       "Columns",
     );
   }
-  return { names, hasHeader, delimiter, columns, timeColumn, width, firstLine: lineNo };
+  return columns;
+}
+
+/** The index of the column `ref` (a 0-based index, or a header name) given in `param`. */
+function resolveColumn(ref: ColumnRef, param: string, head: Head, o: ParseOptions): number {
+  const { names, hasHeader, width } = head;
+  if (typeof ref === "number") {
+    if (ref >= width) {
+      throw new BlockConfigError(
+        `column index ${ref} is out of range: '${o.file}' has ${width} column${width === 1 ? "" : "s"} ` +
+          `(valid: 0–${width - 1})`,
+        param,
+      );
+    }
+    return ref;
+  }
+  if (!hasHeader) {
+    throw new BlockConfigError(
+      `column '${ref}' is a name, but '${o.file}' has no header line; give 0-based column indices ` +
+        `(0–${width - 1}) or set Header: true`,
+      param,
+    );
+  }
+  return columnNamed(ref, param, names, o);
+}
+
+/** The index of the header name `ref` (exact, else ignoring case); suggests the closest if none. */
+function columnNamed(ref: string, param: string, names: string[], o: ParseOptions): number {
+  let i = names.indexOf(ref);
+  if (i < 0) i = names.findIndex((n) => n.toLowerCase() === ref.toLowerCase());
+  if (i < 0) {
+    const s = closest(ref, names);
+    throw new BlockConfigError(
+      `'${o.file}' has no column '${ref}' (its columns: ${listNames(names)})` +
+        (s !== undefined ? `; did you mean ${quote(s)}?` : ""),
+      param,
+    );
+  }
+  return i;
 }
 
 /**
