@@ -13,7 +13,7 @@
 import { readFileSync, statSync, writeFileSync } from "node:fs";
 import { dirname, join, resolve } from "node:path";
 import { parseArgs } from "node:util";
-import { formatDiagnostic } from "../engine/diagnostics";
+import { formatDiagnostic, type Diagnostic } from "../engine/diagnostics";
 import type { SimulateOptions } from "../engine/pipeline/simulate";
 import { Host, webRoot } from "../host/host";
 import type { Served } from "../host/serve";
@@ -149,7 +149,37 @@ async function cmdValidate(args: string[]): Promise<number> {
 }
 
 async function cmdFormat(args: string[]): Promise<number> {
-  let values: { check: boolean };
+  const parsed = parseFormatArgs(args);
+  if (typeof parsed === "number") return parsed;
+  const { check, files } = parsed;
+  // The same full check as `mosaic validate` (loader, then every block instantiated).
+  const { loadDspFromDisk, validatePipelineFile } = await import("../host/validate");
+  const { PipelineDocument } = await import("../engine/pipeline/document");
+  loadDspFromDisk();
+  const tools: FormatTools = { validate: validatePipelineFile, Document: PipelineDocument };
+  let invalid = false;
+  let changed = 0;
+  for (const f of files) {
+    const outcome = await formatFile(f, check, tools);
+    if (outcome === "invalid") invalid = true;
+    else if (outcome === "changed") changed++;
+  }
+  if (invalid) return 2;
+  return check && changed > 0 ? 1 : 0;
+}
+
+/** What `mosaic format` uses, loaded on demand: validatePipelineFile and PipelineDocument. */
+interface FormatTools {
+  validate(file: string): Promise<Diagnostic[]>;
+  Document: { parse(text: string, file: string): { normalize(): void; toString(): string } };
+}
+
+/** What came of one file: invalid (or unreadable, unwritable), unchanged, changed (or would be). */
+type FormatOutcome = "invalid" | "unchanged" | "changed";
+
+/** `mosaic format`'s `--check` and files, or the exit status after a usage error. */
+function parseFormatArgs(args: string[]): { check: boolean; files: string[] } | number {
+  let check: boolean;
   let files: string[];
   try {
     const r = parseArgs({
@@ -157,7 +187,7 @@ async function cmdFormat(args: string[]): Promise<number> {
       allowPositionals: true,
       options: { check: { type: "boolean", default: false } },
     });
-    values = { check: r.values.check };
+    check = r.values.check;
     files = r.positionals;
   } catch (e) {
     err(`mosaic format: ${(e as Error).message}`);
@@ -167,53 +197,55 @@ async function cmdFormat(args: string[]): Promise<number> {
     err("usage: mosaic format FILE... [--check]");
     return 2;
   }
-  // The same full check as `mosaic validate` (loader, then every block instantiated).
-  const { loadDspFromDisk, validatePipelineFile } = await import("../host/validate");
-  const { PipelineDocument } = await import("../engine/pipeline/document");
-  loadDspFromDisk();
-  let invalid = false;
-  let changed = 0;
-  for (const f of files) {
-    const ds = await validatePipelineFile(f);
-    const errors = ds.filter((d) => d.severity === "error");
-    if (errors.length > 0) {
-      for (const d of errors) err(formatDiagnostic(d));
-      err(`${f}: invalid (${errors.length} error${errors.length === 1 ? "" : "s"}), not formatted`);
-      invalid = true;
-      continue;
-    }
-    let source: string;
-    let formatted: string;
-    try {
-      source = readFileSync(f, "utf8");
-      const doc = PipelineDocument.parse(source, f);
-      doc.normalize();
-      formatted = doc.toString();
-    } catch (e) {
-      err(`${f}: ${(e as Error).message}`);
-      invalid = true;
-      continue;
-    }
-    if (formatted === source) {
-      out(`${f}: unchanged`);
-      continue;
-    }
-    changed++;
-    if (values.check) {
-      out(`${f}: would change`);
-      continue;
-    }
-    try {
-      writeFileSync(f, formatted);
-    } catch (e) {
-      err(`${f}: cannot write: ${(e as Error).message}`);
-      invalid = true;
-      continue;
-    }
-    out(`${f}: formatted`);
+  return { check, files };
+}
+
+/** Validates, formats and (unless `check`) rewrites one file, saying so on stdout or stderr. */
+async function formatFile(f: string, check: boolean, tools: FormatTools): Promise<FormatOutcome> {
+  if (!(await validForFormat(f, tools.validate))) return "invalid";
+  const r = formatSource(f, tools.Document);
+  if (!r) return "invalid";
+  if (r.formatted === r.source) {
+    out(`${f}: unchanged`);
+    return "unchanged";
   }
-  if (invalid) return 2;
-  return values.check && changed > 0 ? 1 : 0;
+  if (check) {
+    out(`${f}: would change`);
+    return "changed";
+  }
+  try {
+    writeFileSync(f, r.formatted);
+  } catch (e) {
+    err(`${f}: cannot write: ${(e as Error).message}`);
+    return "invalid";
+  }
+  out(`${f}: formatted`);
+  return "changed";
+}
+
+/** True when the file has no errors; otherwise prints them and says it is not formatted. */
+async function validForFormat(f: string, validate: FormatTools["validate"]): Promise<boolean> {
+  const errors = (await validate(f)).filter((d) => d.severity === "error");
+  if (errors.length === 0) return true;
+  for (const d of errors) err(formatDiagnostic(d));
+  err(`${f}: invalid (${errors.length} error${errors.length === 1 ? "" : "s"}), not formatted`);
+  return false;
+}
+
+/** The file's text and its canonical form; undefined (after saying why) when it cannot be read. */
+function formatSource(
+  f: string,
+  Document: FormatTools["Document"],
+): { source: string; formatted: string } | undefined {
+  try {
+    const source = readFileSync(f, "utf8");
+    const doc = Document.parse(source, f);
+    doc.normalize();
+    return { source, formatted: doc.toString() };
+  } catch (e) {
+    err(`${f}: ${(e as Error).message}`);
+    return undefined;
+  }
 }
 
 /**

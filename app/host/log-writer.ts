@@ -116,57 +116,50 @@ export class LogWriter {
   ): string {
     const rel = logFileName(path, block, port, isDefaultPort);
     const file = isAbsolute(rel) ? rel : resolve(this.baseDir, rel);
-    const l: OpenLog = {
-      key,
-      block,
-      file,
-      fd: -1,
-      identity: undefined,
-      regular: false,
-      bytes: 0,
-      ring: new SabRing(ring),
-      frame: new Frame(shape, 4096),
-      lines: 0,
-      lost: 0,
-      droppedReported: 0,
-      error: undefined,
-      retryAt: Infinity,
-    };
+    const l = newLog(key, block, file, shape, ring);
     this.logs.set(key, l);
-    const refuse = (message: string): void => {
-      l.error = message;
-      this.events.onError(file, message);
-    };
+    this.openFile(l);
+    if (!this.timer) {
+      this.timer = setInterval(() => this.drainAll(), this.intervalMs);
+    }
+    return file;
+  }
+
+  /** Opens the log's file unless another log writes it; either failure is the log's error. */
+  private openFile(l: OpenLog): void {
+    const { block, file } = l;
     try {
       mkdirSync(dirname(file), { recursive: true });
       // Refused before opening: opening truncates, and the other log's lines would go.
       const before = statOrUndefined(file);
       const other = before?.isFile() ? writing.get(identityOf(before)) : undefined;
-      if (other) {
-        refuse(
-          `the log of '${block}' cannot be written: ${file} is already written by the log of ` +
-            `'${other.block}'${other.file !== file ? ` (as ${other.file})` : ""}; two writers ` +
-            "on one file tear and lose lines: give one of them another Path (its events are " +
-            "counted as lost)",
-        );
-      } else {
-        const fd = openSync(file, "w");
-        const st = fstatSync(fd);
-        l.fd = fd;
-        l.regular = st.isFile();
-        if (l.regular) {
-          l.identity = identityOf(st);
-          writing.set(l.identity, { block, file });
-        }
-        this.opened.push(file);
-      }
+      if (other) this.refuse(l, sharedFileMessage(block, file, other));
+      else this.startWriting(l);
     } catch (e) {
-      refuse(`cannot open log file: ${(e as Error).message} (the log of '${block}' is lost)`);
+      this.refuse(
+        l,
+        `cannot open log file: ${(e as Error).message} (the log of '${block}' is lost)`,
+      );
     }
-    if (!this.timer) {
-      this.timer = setInterval(() => this.drainAll(), this.intervalMs);
+  }
+
+  /** Opens (truncates) the log's file and, for a regular file, claims it for this log. */
+  private startWriting(l: OpenLog): void {
+    const fd = openSync(l.file, "w");
+    const st = fstatSync(fd);
+    l.fd = fd;
+    l.regular = st.isFile();
+    if (l.regular) {
+      l.identity = identityOf(st);
+      writing.set(l.identity, { block: l.block, file: l.file });
     }
-    return file;
+    this.opened.push(l.file);
+  }
+
+  /** The log is not written, for `message`: one error. */
+  private refuse(l: OpenLog, message: string): void {
+    l.error = message;
+    this.events.onError(l.file, message);
   }
 
   /** Drains, writes and closes one log. */
@@ -304,6 +297,46 @@ export class LogWriter {
       l.droppedReported = dropped;
     }
   }
+}
+
+/** A log of `block` into `file`, not yet open. */
+function newLog(
+  key: string,
+  block: string,
+  file: string,
+  shape: Shape,
+  ring: SabRingInit,
+): OpenLog {
+  return {
+    key,
+    block,
+    file,
+    fd: -1,
+    identity: undefined,
+    regular: false,
+    bytes: 0,
+    ring: new SabRing(ring),
+    frame: new Frame(shape, 4096),
+    lines: 0,
+    lost: 0,
+    droppedReported: 0,
+    error: undefined,
+    retryAt: Infinity,
+  };
+}
+
+/** The error of a log refused because `other` already writes its file. */
+function sharedFileMessage(
+  block: string,
+  file: string,
+  other: { block: string; file: string },
+): string {
+  return (
+    `the log of '${block}' cannot be written: ${file} is already written by the log of ` +
+    `'${other.block}'${other.file !== file ? ` (as ${other.file})` : ""}; two writers ` +
+    "on one file tear and lose lines: give one of them another Path (its events are " +
+    "counted as lost)"
+  );
 }
 
 function statOrUndefined(file: string): Stats | undefined {

@@ -52,78 +52,117 @@ function asToRelay(d: unknown): ToRelay | undefined {
 
 /** Lends `client`'s engine to participant windows on channel `id`; returns the stop function. */
 export function startParticipantRelay(client: EngineClient, channel: ChannelLike): () => void {
-  /** Participants that said hello, with the watches each holds (key → stop). */
-  const participants = new Map<string, Map<string, () => void>>();
-  const post = (to: string, msg: EngineMessage): void =>
-    channel.postMessage({ to, msg } satisfies FromRelay);
-  const everyone = (msg: EngineMessage): void => {
-    if (participants.size > 0) post("*", msg);
-  };
-  const hello = (): EngineMessage => ({
-    type: "hello",
-    version: PROTOCOL_VERSION,
-    engine: client.engineName,
-    sharedMemory: client.sharedMemory,
-  });
-
-  const greet = (from: string): void => {
-    drop(from);
-    participants.set(from, new Map());
-    post(from, hello());
-    if (client.graph) post(from, { type: "graph", graph: client.graph });
-    post(from, { type: "state", state: client.state });
-    if (client.telemetry) post(from, { type: "telemetry", telemetry: client.telemetry });
-  };
-  const drop = (from: string): void => {
-    for (const off of participants.get(from)?.values() ?? []) off();
-    participants.delete(from);
-  };
-  const reply = (to: string, id: number, ok: boolean, message?: string): void =>
-    post(to, { type: "reply", id, ok, ...(message !== undefined ? { message } : {}) });
-
-  const handle = (from: string, msg: UiMessage): void => {
-    if (msg.type === "hello") return greet(from);
-    const mine = participants.get(from);
-    if (!("id" in msg)) return;
-    if (!mine) return reply(from, msg.id, false, "say hello first");
-    if (msg.type === "watch" || msg.type === "unwatch") {
-      const key = `${msg.block}\u0000${msg.port ?? ""}`;
-      mine.get(key)?.();
-      mine.delete(key);
-      if (msg.type === "watch") {
-        mine.set(
-          key,
-          client.watch(msg.block, msg.port, (m) => post(from, m), msg.maxRate),
-        );
-      }
-      return reply(from, msg.id, true);
-    }
-    reply(from, msg.id, false, "the participant window only shows the session");
-  };
-
-  const listener = (e: { data: unknown }): void => {
-    const m = asToRelay(e.data);
-    if (!m) return;
-    if ("bye" in m) drop(m.from);
-    else handle(m.from, m.msg);
-  };
-  channel.addEventListener("message", listener);
-  const offs = [
-    client.onHello(() => everyone(hello())),
-    client.onState((state) => everyone({ type: "state", state })),
-    client.onTelemetry((telemetry) => everyone({ type: "telemetry", telemetry })),
-    client.onGraph((graph: GraphInfo | undefined) => {
-      if (graph) everyone({ type: "graph", graph });
-    }),
-  ];
+  const relay = new ParticipantRelay(client, channel);
+  channel.addEventListener("message", (e) => relay.receive(e.data));
+  const offs = relay.followClient();
   // Participant windows opened before this page (or before it reloaded) say hello again.
   channel.postMessage({ relayUp: true } satisfies FromRelay);
   return () => {
     for (const off of offs) off();
-    for (const from of [...participants.keys()]) drop(from);
+    relay.dropAll();
     channel.postMessage({ relayDown: true } satisfies FromRelay);
     channel.close();
   };
+}
+
+type WatchMessage = Extract<UiMessage, { type: "watch" | "unwatch" }>;
+
+/** The clinician side's state: who said hello, what each watches, and how to answer them. */
+class ParticipantRelay {
+  /** Participants that said hello, with the watches each holds (key → stop). */
+  private readonly participants = new Map<string, Map<string, () => void>>();
+
+  constructor(
+    private readonly client: EngineClient,
+    private readonly channel: ChannelLike,
+  ) {}
+
+  /** One message from the channel: a participant's protocol message or goodbye. */
+  receive(data: unknown): void {
+    const m = asToRelay(data);
+    if (!m) return;
+    if ("bye" in m) this.drop(m.from);
+    else this.handle(m.from, m.msg);
+  }
+
+  /** Passes the clinician client's hello, state, telemetry and graph on to every participant. */
+  followClient(): (() => void)[] {
+    const { client } = this;
+    return [
+      client.onHello(() => this.everyone(this.hello())),
+      client.onState((state) => this.everyone({ type: "state", state })),
+      client.onTelemetry((telemetry) => this.everyone({ type: "telemetry", telemetry })),
+      client.onGraph((graph: GraphInfo | undefined) => {
+        if (graph) this.everyone({ type: "graph", graph });
+      }),
+    ];
+  }
+
+  /** Forgets every participant, stopping their watches. */
+  dropAll(): void {
+    for (const from of [...this.participants.keys()]) this.drop(from);
+  }
+
+  private post(to: string, msg: EngineMessage): void {
+    this.channel.postMessage({ to, msg } satisfies FromRelay);
+  }
+
+  private everyone(msg: EngineMessage): void {
+    if (this.participants.size > 0) this.post("*", msg);
+  }
+
+  private hello(): EngineMessage {
+    return {
+      type: "hello",
+      version: PROTOCOL_VERSION,
+      engine: this.client.engineName,
+      sharedMemory: this.client.sharedMemory,
+    };
+  }
+
+  /** (Re)admits a participant and sends it what `mosaic serve` sends a tab that joins. */
+  private greet(from: string): void {
+    const { client } = this;
+    this.drop(from);
+    this.participants.set(from, new Map());
+    this.post(from, this.hello());
+    if (client.graph) this.post(from, { type: "graph", graph: client.graph });
+    this.post(from, { type: "state", state: client.state });
+    if (client.telemetry) this.post(from, { type: "telemetry", telemetry: client.telemetry });
+  }
+
+  private drop(from: string): void {
+    for (const off of this.participants.get(from)?.values() ?? []) off();
+    this.participants.delete(from);
+  }
+
+  private reply(to: string, id: number, ok: boolean, message?: string): void {
+    this.post(to, { type: "reply", id, ok, ...(message !== undefined ? { message } : {}) });
+  }
+
+  /** A participant's protocol message: hello, watch and unwatch are answered, the rest refused. */
+  private handle(from: string, msg: UiMessage): void {
+    if (msg.type === "hello") return this.greet(from);
+    const mine = this.participants.get(from);
+    if (!("id" in msg)) return;
+    if (!mine) return this.reply(from, msg.id, false, "say hello first");
+    if (msg.type === "watch" || msg.type === "unwatch") return this.watch(from, mine, msg);
+    this.reply(from, msg.id, false, "the participant window only shows the session");
+  }
+
+  /** Replaces (watch) or stops (unwatch) the participant's watch of one block's port. */
+  private watch(from: string, mine: Map<string, () => void>, msg: WatchMessage): void {
+    const key = `${msg.block}\u0000${msg.port ?? ""}`;
+    mine.get(key)?.();
+    mine.delete(key);
+    if (msg.type === "watch") {
+      mine.set(
+        key,
+        this.client.watch(msg.block, msg.port, (m) => this.post(from, m), msg.maxRate),
+      );
+    }
+    this.reply(from, msg.id, true);
+  }
 }
 
 /** The participant side's connection, which also says when the clinician's page comes and goes. */

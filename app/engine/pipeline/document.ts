@@ -733,61 +733,7 @@ export class PipelineDocument {
     for (const pair of root.items) {
       const holder = str(pair.key);
       if (holder === undefined || !isMap(pair.value)) continue;
-      for (const it of pair.value.items) {
-        const k = keyOf(it);
-        if (k === "Inputs") {
-          const items = isSeq(it.value) ? it.value.items : [it.value];
-          for (const n of items) {
-            const s = isScalar(n) && typeof n.value === "string" ? n.value : undefined;
-            if (s === undefined || s === "") continue;
-            out.push({
-              holder,
-              kind: "input",
-              node: n as Scalar,
-              value: s,
-              target: referencedBlock(s),
-            });
-          }
-        } else if (k === "Params" && isMap(it.value)) {
-          for (const q of it.value.items) {
-            const v = q.value;
-            if (
-              BLOCK_REF_PARAMS.has(String(keyOf(q))) &&
-              isScalar(v) &&
-              typeof v.value === "string"
-            ) {
-              out.push({
-                holder,
-                kind: "trigger",
-                node: v,
-                value: v.value,
-                target: referencedBlock(v.value),
-              });
-            }
-          }
-        } else if (k === "Params" && isSeq(it.value)) {
-          for (const n of it.value.items) {
-            if (isScalar(n) && typeof n.value === "string") {
-              const m = /^\s*timerBlockName\s*:\s*(.*?)\s*$/.exec(n.value);
-              if (m && m[1]) {
-                out.push({ holder, kind: "legacy-trigger", node: n, value: n.value, target: m[1] });
-              }
-            } else if (isMap(n) && n.items.length === 1) {
-              const q = n.items[0]!;
-              const v = q.value;
-              if (keyOf(q) === LEGACY_TRIGGER && isScalar(v) && typeof v.value === "string") {
-                out.push({
-                  holder,
-                  kind: "legacy-trigger-value",
-                  node: v,
-                  value: v.value,
-                  target: v.value.trim(),
-                });
-              }
-            }
-          }
-        }
-      }
+      for (const it of pair.value.items) keyReferences(holder, it, out);
     }
     return out;
   }
@@ -944,6 +890,70 @@ export class PipelineDocument {
       this.text = text;
       this.doc = doc;
       throw e;
+    }
+  }
+}
+
+/** The references in one key (`Inputs` or `Params`) of block `holder`, added to `out`. */
+function keyReferences(holder: string, it: Pair, out: Reference[]): void {
+  const k = keyOf(it);
+  if (k === "Inputs") inputReferences(holder, it.value, out);
+  else if (k === "Params" && isMap(it.value)) triggerReferences(holder, it.value, out);
+  else if (k === "Params" && isSeq(it.value)) legacyTriggerReferences(holder, it.value, out);
+}
+
+/** The items of an `Inputs` value (a list, or one item) that name a block. */
+function inputReferences(holder: string, value: unknown, out: Reference[]): void {
+  const items = isSeq(value) ? value.items : [value];
+  for (const n of items) {
+    const s = isScalar(n) && typeof n.value === "string" ? n.value : undefined;
+    if (s === undefined || s === "") continue;
+    out.push({
+      holder,
+      kind: "input",
+      node: n as Scalar,
+      value: s,
+      target: referencedBlock(s),
+    });
+  }
+}
+
+/** Named params that name a block (a Joiner's `Trigger`). */
+function triggerReferences(holder: string, params: YAMLMap, out: Reference[]): void {
+  for (const q of params.items) {
+    const v = q.value;
+    if (BLOCK_REF_PARAMS.has(String(keyOf(q))) && isScalar(v) && typeof v.value === "string") {
+      out.push({
+        holder,
+        kind: "trigger",
+        node: v,
+        value: v.value,
+        target: referencedBlock(v.value),
+      });
+    }
+  }
+}
+
+/** Positional params that name a block: MOSAIC's `timerBlockName`, in either form. */
+function legacyTriggerReferences(holder: string, params: YAMLSeq, out: Reference[]): void {
+  for (const n of params.items) {
+    if (isScalar(n) && typeof n.value === "string") {
+      const m = /^\s*timerBlockName\s*:\s*(.*?)\s*$/.exec(n.value);
+      if (m && m[1]) {
+        out.push({ holder, kind: "legacy-trigger", node: n, value: n.value, target: m[1] });
+      }
+    } else if (isMap(n) && n.items.length === 1) {
+      const q = n.items[0]!;
+      const v = q.value;
+      if (keyOf(q) === LEGACY_TRIGGER && isScalar(v) && typeof v.value === "string") {
+        out.push({
+          holder,
+          kind: "legacy-trigger-value",
+          node: v,
+          value: v.value,
+          target: v.value.trim(),
+        });
+      }
     }
   }
 }

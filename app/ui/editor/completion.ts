@@ -4,7 +4,7 @@
  */
 import type { CatalogInfo } from "../../engine/protocol";
 import type { JsonSchema } from "../forms/schema";
-import { readBlocks, typeIndex } from "./model";
+import { readBlocks, typeIndex, type EditBlock } from "./model";
 
 export interface Completion {
   label: string;
@@ -35,55 +35,70 @@ export function completeAt(
   const word = /[A-Za-z_][\w-]*$/.exec(before)?.[0] ?? "";
   const from = pos - word.length;
   const head = before.slice(0, before.length - word.length);
-  const types = catalog?.types ?? [];
-  if (/\bType:\s*$/.test(head)) {
-    return {
-      from,
-      options: types.map((t) => ({
-        label: t.type,
-        type: "class",
-        detail: t.category,
-        info: t.summary,
-      })),
-    };
-  }
+  if (/\bType:\s*$/.test(head)) return { from, options: typeOptions(catalog) };
   const lineNo = text.slice(0, lineStart).split("\n").length;
   const { blocks } = readBlocks(text);
-  const names = blocks.map((b) => b.name);
   // The block the cursor is in: the last one that starts on or above its line.
   const here = [...blocks].reverse().find((b) => b.line > 0 && b.line <= lineNo);
   if (/\bInputs:\s*\[[^\]]*$/.test(head) || /^\s*-\s*$/.test(head)) {
-    return {
-      from,
-      options: names.filter((n) => n !== here?.name).map((n) => ({ label: n, type: "variable" })),
-    };
+    return { from, options: inputOptions(blocks, here) };
   }
+  const params = paramOptions(here, catalog);
+  if (/\bParams:\s*\{[^}]*$/.test(head)) return { from, options: params };
+  // Block style: a key under `Params:` (indented deeper than it), or a key of the block.
+  const indent = /^\s*/.exec(before)![0].length;
+  if (here && /^\s*$/.test(head) && indent > 0) {
+    const lines = text.slice(0, lineStart).split("\n");
+    return { from, options: underParams(lines, here.line, indent) ? params : keyOptions() };
+  }
+  if (/[{,]\s*$/.test(head) && here) return { from, options: keyOptions() };
+  return null;
+}
+
+/** Every block type of the catalog. */
+function typeOptions(catalog: CatalogInfo | undefined): Completion[] {
+  const types = catalog?.types ?? [];
+  return types.map((t) => ({
+    label: t.type,
+    type: "class",
+    detail: t.category,
+    info: t.summary,
+  }));
+}
+
+/** Every block name but the one the cursor is in. */
+function inputOptions(blocks: EditBlock[], here: EditBlock | undefined): Completion[] {
+  const names = blocks.map((b) => b.name);
+  return names.filter((n) => n !== here?.name).map((n) => ({ label: n, type: "variable" }));
+}
+
+/** The param names of the type of the block the cursor is in (none outside a known type). */
+function paramOptions(here: EditBlock | undefined, catalog: CatalogInfo | undefined): Completion[] {
   const t = here ? typeIndex(catalog).get(here.type) : undefined;
-  const params = t
+  return t
     ? Object.entries((t.paramsSchema as JsonSchema).properties ?? {}).map(([name, s]) => ({
         label: name,
         type: "property",
         ...(typeof s.description === "string" ? { info: s.description } : {}),
       }))
     : [];
-  if (/\bParams:\s*\{[^}]*$/.test(head)) return { from, options: params };
-  // Block style: a key under `Params:` (indented deeper than it), or a key of the block.
-  const lines = text.slice(0, lineStart).split("\n");
-  const indent = /^\s*/.exec(before)![0].length;
-  if (here && /^\s*$/.test(head) && indent > 0) {
-    for (let i = lines.length - 1; i >= here.line - 1 && i >= 0; i--) {
-      const l = lines[i]!;
-      if (l.trim() === "" || l.trim().startsWith("#")) continue;
-      const ind = /^\s*/.exec(l)![0].length;
-      if (ind < indent) {
-        if (/^\s*Params:\s*$/.test(l)) return { from, options: params };
-        break;
-      }
-    }
-    return { from, options: BLOCK_KEYS.map((k) => ({ ...k, type: "keyword" })) };
+}
+
+/** The keys a block may have. */
+function keyOptions(): Completion[] {
+  return BLOCK_KEYS.map((k) => ({ ...k, type: "keyword" }));
+}
+
+/**
+ * Whether the cursor's line, indented by `indent`, is under a `Params:` line: the nearest line
+ * above it (from the block's first line, `blockLine`, 1-based) indented less than it.
+ */
+function underParams(lines: string[], blockLine: number, indent: number): boolean {
+  for (let i = lines.length - 1; i >= blockLine - 1 && i >= 0; i--) {
+    const l = lines[i]!;
+    if (l.trim() === "" || l.trim().startsWith("#")) continue;
+    const ind = /^\s*/.exec(l)![0].length;
+    if (ind < indent) return /^\s*Params:\s*$/.test(l);
   }
-  if (/[{,]\s*$/.test(head) && here) {
-    return { from, options: BLOCK_KEYS.map((k) => ({ ...k, type: "keyword" })) };
-  }
-  return null;
+  return false;
 }
