@@ -159,10 +159,7 @@ function emitJoined(out: OutputPort, f: Frame, joined: Float64Array, off: number
   const v = f.v;
   for (let e = 0; e < n; e++) {
     o.t[e] = ft[e]!;
-    if (off >= 0) {
-      const src = e * w;
-      for (let k = 0; k < w; k++) joined[off + k] = v[src + k]!;
-    }
+    if (off >= 0) copyEvent(joined, off, v, e, w);
     const dst = e * width;
     for (let k = 0; k < width; k++) ov[dst + k] = joined[k]!;
   }
